@@ -1,0 +1,373 @@
+"""Simulate a chain and read the result bead by bead (beads 1..N, contacts 1..N-1).
+
+>>> from chain import uniform_chain, simulate
+>>> result = simulate(uniform_chain(25), v_left=0.1, v_right=0.1, duration=1.5e-3)
+>>> result.time            # (S,) s
+>>> result.force_felt(9)   # (B, S) N, (F_{8,9} + F_{9,10}) / 2 as in the paper's Fig. 3
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from chain.integrator import DEFAULT_MAX_ENERGY_DRIFT, RawTrajectory, integrate
+from chain.materials import ParameterError, require_positive
+from chain.model import HERTZ, SPRING, ChainModel, launch_velocities
+from chain.theory import hertz_contact_time
+from chain.traces import META_COLUMNS, sensor_column
+
+#: Steps per shortest two-body contact time in the default time step. The exact
+#: Hertz scaling makes the energy drift a function of dt / t_c only; 3000 keeps the
+#: conservative drift of the paper's N = 26 chain below 1e-9 over 2.6 ms up to
+#: 1 m/s (RK4 loses order at the delta^(3/2) kink when a contact opens, hence the
+#: many steps).
+STEPS_PER_CONTACT_TIME = 3000
+
+#: Steps per period of the stiffest bonded spring (sensor beads) in the default step.
+STEPS_PER_SPRING_PERIOD = 400
+
+#: Default recording interval, s.
+DEFAULT_RECORD_INTERVAL = 1e-6
+
+
+def default_time_step(model: ChainModel, max_launch_speed: float) -> float:
+    """A time step that keeps the conservative energy drift near 1e-9 or below, s.
+
+    The shortest Hertz contact time of any linked pair at a relative speed of twice
+    the fastest launch (a head-on collision), divided by
+    :data:`STEPS_PER_CONTACT_TIME`, and the shortest bonded-spring period divided by
+    :data:`STEPS_PER_SPRING_PERIOD`, whichever is smaller.
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain.
+    max_launch_speed : float
+        Largest launch speed of the run, m/s.
+    """
+    max_launch_speed = require_positive("max_launch_speed", max_launch_speed)
+    masses = model.masses
+    shortest = math.inf
+    for j, kind in enumerate(model.link_kind):
+        m_a, m_b = masses[j], masses[j + 1]
+        if kind == HERTZ:
+            # Halves of a sensor bead move together: use whole-bead masses around them.
+            m_a, m_b = _moving_mass(model, j), _moving_mass(model, j + 1)
+            contact = hertz_contact_time(m_a, m_b, model.link_stiffness[j], 2 * max_launch_speed)
+            shortest = min(shortest, contact / STEPS_PER_CONTACT_TIME)
+        elif kind == SPRING:
+            reduced = m_a * m_b / (m_a + m_b)
+            period = 2 * math.pi * math.sqrt(reduced / model.link_stiffness[j])
+            shortest = min(shortest, period / STEPS_PER_SPRING_PERIOD)
+    for side, particle in ((0, 0), (1, model.n_particles - 1)):
+        if model.wall_stiffness[side] > 0:
+            contact = hertz_contact_time(
+                _moving_mass(model, particle), math.inf, model.wall_stiffness[side],
+                2 * max_launch_speed,
+            )
+            shortest = min(shortest, contact / STEPS_PER_CONTACT_TIME)
+    return shortest
+
+
+def _moving_mass(model: ChainModel, particle: int) -> float:
+    for first, last in zip(model.bead_first, model.bead_last):
+        if first <= particle <= last:
+            return float(model.masses[first : last + 1].sum())
+    return float(model.masses[particle])
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """A batch of simulated launches of one chain, indexed the way a person reads it.
+
+    Attributes
+    ----------
+    model : ChainModel
+    time : (S,) s
+    v_left, v_right : (B,) launch speeds, m/s
+    contact_force : (B, S, N-1) N; contact k (joining beads k, k+1) at index k-1
+    end_force : (B, S, 2) N; force on bead 1 from its left (wall or striker) and on bead
+        N from its right; zero for a free end
+    bead_velocity : (B, S, N) m/s; centre-of-mass velocity of each bead
+    sensor_force : (B, S, n_sensors) N; sensor-spring readings k_s * compression
+    kinetic_energy, potential_energy, dissipated_energy : (B, S) J
+    momentum : (B, S) kg m/s (all particles, strikers included)
+    dt : s, the integration step
+    """
+
+    model: ChainModel
+    time: np.ndarray
+    v_left: np.ndarray
+    v_right: np.ndarray
+    contact_force: np.ndarray
+    end_force: np.ndarray
+    bead_velocity: np.ndarray
+    sensor_force: np.ndarray
+    kinetic_energy: np.ndarray
+    potential_energy: np.ndarray
+    dissipated_energy: np.ndarray
+    momentum: np.ndarray
+    dt: float
+
+    @property
+    def total_energy(self) -> np.ndarray:
+        """E_kin + E_pot + E_diss, (B, S) J; constant up to integration error."""
+        return self.kinetic_energy + self.potential_energy + self.dissipated_energy
+
+    @property
+    def energy_drift(self) -> np.ndarray:
+        """Largest relative change of :attr:`total_energy` per launch, (B,)."""
+        total = self.total_energy
+        return np.max(np.abs(total - total[:, :1]), axis=1) / np.abs(total[:, 0])
+
+    def contact(self, k: int) -> np.ndarray:
+        """Force of contact k (beads k and k+1), (B, S) N."""
+        if not isinstance(k, int | np.integer) or not 1 <= k <= self.model.n_beads - 1:
+            raise ParameterError(f"contact must be in 1..{self.model.n_beads - 1}, got {k!r}")
+        return self.contact_force[:, :, k - 1]
+
+    def force_felt(self, bead: int) -> np.ndarray:
+        """Force "felt by" bead n, (F_{n-1,n} + F_{n,n+1}) / 2, (B, S) N.
+
+        What a piezo inside a bead cut in two reads when the sensor is not modelled
+        (the paper's Fig. 3). At an end the missing contact is the wall or striker
+        force (zero for a free end).
+        """
+        index = self.model.bead_index(bead)
+        n = self.model.n_beads
+        left = self.end_force[:, :, 0] if index == 0 else self.contact_force[:, :, index - 1]
+        right = self.end_force[:, :, 1] if index == n - 1 else self.contact_force[:, :, index]
+        return 0.5 * (left + right)
+
+    def sensor(self, bead: int) -> np.ndarray:
+        """Reading of the split sensor bead ``bead``, k_s times its compression, (B, S) N."""
+        if bead not in self.model.sensor_beads:
+            raise ParameterError(
+                f"bead {bead} is not a sensor bead; sensor beads: {list(self.model.sensor_beads)}"
+            )
+        return self.sensor_force[:, :, self.model.sensor_beads.index(bead)]
+
+    def velocity(self, bead: int) -> np.ndarray:
+        """Velocity of bead n, (B, S) m/s."""
+        return self.bead_velocity[:, :, self.model.bead_index(bead)]
+
+
+def simulate(
+    model: ChainModel,
+    v_left,
+    v_right=0.0,
+    duration: float = 2.6e-3,
+    dt: float | None = None,
+    record_interval: float = DEFAULT_RECORD_INTERVAL,
+    max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
+) -> SimulationResult:
+    """Launch waves from both ends of ``model`` (a batch of launches) and integrate.
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain (see :func:`chain.model.uniform_chain`).
+    v_left : float or array of B floats
+        Speed given to bead 1 (or the left striker), moving right, m/s.
+    v_right : float or array of B floats
+        Speed given to bead N (or the right striker), moving left, m/s; 0 for a
+        reference (single-wave) run.
+    duration : float
+        Simulated time, s.
+    dt : float, optional
+        RK4 time step, s; default :func:`default_time_step` at the fastest launch.
+    record_interval : float
+        Time between recorded samples, s; rounded to a whole number of steps.
+    max_energy_drift : float
+        Raise :class:`~chain.integrator.IntegrationError` above this relative drift.
+    """
+    velocities = launch_velocities(model, v_left, v_right)
+    left = np.atleast_1d(np.asarray(v_left, dtype=float))
+    right = np.atleast_1d(np.asarray(v_right, dtype=float))
+    left, right = np.broadcast_arrays(left, right)
+    fastest = float(max(left.max(), right.max()))
+    if fastest <= 0:
+        raise ParameterError("v_left or v_right must be > 0 m/s in at least one launch")
+    if dt is None:
+        dt = default_time_step(model, fastest)
+    dt = require_positive("dt", dt)
+    record_interval = require_positive("record_interval", record_interval)
+    record_every = max(1, round(record_interval / dt))
+    raw = integrate(
+        model, velocities, duration, dt, record_every=record_every,
+        max_energy_drift=max_energy_drift,
+    )
+    return _bead_view(model, raw, left.copy(), right.copy())
+
+
+def _bead_view(model: ChainModel, raw: RawTrajectory, left, right) -> SimulationResult:
+    masses = model.masses
+    velocity = np.stack(
+        [
+            (raw.velocity[:, :, a : b + 1] * masses[a : b + 1]).sum(axis=2) / masses[a : b + 1].sum()
+            for a, b in zip(model.bead_first, model.bead_last)
+        ],
+        axis=2,
+    )
+    end_force = raw.wall_force.copy()
+    if model.left_striker >= 0:
+        end_force[:, :, 0] = raw.link_force[:, :, model.left_striker]
+    if model.right_striker >= 0:
+        end_force[:, :, 1] = raw.link_force[:, :, model.right_striker - 1]
+    return SimulationResult(
+        model=model,
+        time=raw.time,
+        v_left=left,
+        v_right=right,
+        contact_force=raw.link_force[:, :, model.contact_link],
+        end_force=end_force,
+        bead_velocity=velocity,
+        sensor_force=raw.link_force[:, :, model.sensor_link],
+        kinetic_energy=raw.energy[:, :, 0],
+        potential_energy=raw.energy[:, :, 1],
+        dissipated_energy=raw.energy[:, :, 2],
+        momentum=raw.momentum,
+        dt=raw.dt,
+    )
+
+
+def trace_table(
+    result: SimulationResult,
+    beads,
+    *,
+    kind: str,
+    model_name: str,
+    source: str = "simulation",
+    readout: str = "felt",
+    first_shot: int = 0,
+    amplitudes=None,
+) -> pd.DataFrame:
+    """The forces at ``beads`` of every launch of ``result`` as a trace table
+    (:mod:`chain.traces`), one shot per launch.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        A batch of launches.
+    beads : sequence of int
+        Beads to read (1..N), S1 first.
+    kind : {"collision", "reference"}
+        Shot kind written in the table.
+    model_name : str
+        Value of the ``model`` column.
+    source : str
+        Value of the ``source`` column.
+    readout : {"felt", "sensor"}
+        ``felt``: (F_{n-1,n} + F_{n,n+1}) / 2 (sensors not modelled); ``sensor``: the
+        split-bead sensor reading (the beads must be sensor beads of the model).
+    first_shot : int
+        Shot id of the first launch; launches get consecutive ids.
+    amplitudes : sequence of int, optional
+        Amplitude index per launch (default 0..B-1).
+    """
+    if readout not in ("felt", "sensor"):
+        raise ParameterError(f"readout must be 'felt' or 'sensor', got {readout!r}")
+    read = result.force_felt if readout == "felt" else result.sensor
+    columns = {sensor_column(b): read(b) for b in beads}
+    batch, samples = result.contact_force.shape[:2]
+    amplitudes = np.arange(batch) if amplitudes is None else np.asarray(amplitudes)
+    if amplitudes.shape != (batch,):
+        raise ParameterError(f"amplitudes must have {batch} entries, got {amplitudes.shape}")
+    table = pd.DataFrame(
+        {
+            "source": source,
+            "model": model_name,
+            "N": result.model.n_beads,
+            "shot": np.repeat(np.arange(first_shot, first_shot + batch), samples),
+            "kind": kind,
+            "amplitude": np.repeat(amplitudes, samples),
+            "v0_left_m_s": np.repeat(result.v_left, samples),
+            "v0_right_m_s": np.repeat(result.v_right, samples),
+            "t_s": np.tile(result.time, batch),
+            **{name: values.reshape(-1) for name, values in columns.items()},
+        }
+    )
+    return table[list(META_COLUMNS) + list(columns)]
+
+
+def simulate_shots(
+    model: ChainModel,
+    launch_speeds,
+    sensor_beads,
+    *,
+    model_name: str,
+    duration: float = 2.6e-3,
+    dt: float | None = None,
+    record_interval: float = DEFAULT_RECORD_INTERVAL,
+    readout: str = "felt",
+    max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The paper's simulation protocol for a sweep of launch speeds.
+
+    For each speed V0: a collision shot (+V0 on bead 1, -V0 on bead N) and a reference
+    shot (+V0 on bead 1 alone), all in two batched integrator calls with one time step.
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain.
+    launch_speeds : sequence of float
+        V0 per amplitude, m/s.
+    sensor_beads : sequence of int
+        Beads to record, S1 first (paper: 9, 17 for N = 25; 10, 17 for N = 26).
+    model_name : str
+        Name written in the ``model`` column.
+    duration, dt, record_interval, max_energy_drift
+        As in :func:`simulate`.
+    readout : {"felt", "sensor"}
+        As in :func:`trace_table`.
+
+    Returns
+    -------
+    traces : DataFrame
+        Trace table, collision shots 0..A-1 then reference shots A..2A-1.
+    runs : DataFrame
+        One row per shot: shot, kind, amplitude, v0 values, energy_drift, dt_s,
+        final_energy_J, dissipated_energy_J.
+    """
+    speeds = np.asarray(launch_speeds, dtype=float)
+    if speeds.ndim != 1 or speeds.size == 0 or np.any(~np.isfinite(speeds)) or np.any(speeds <= 0):
+        raise ParameterError(f"launch_speeds must be positive m/s values, got {launch_speeds!r}")
+    if dt is None:
+        dt = default_time_step(model, float(speeds.max()))
+    tables = []
+    runs = []
+    for offset, (kind, right) in enumerate((("collision", speeds), ("reference", 0.0 * speeds))):
+        result = simulate(
+            model, speeds, right, duration=duration, dt=dt, record_interval=record_interval,
+            max_energy_drift=max_energy_drift,
+        )
+        first = offset * len(speeds)
+        tables.append(
+            trace_table(
+                result, sensor_beads, kind=kind, model_name=model_name, readout=readout,
+                first_shot=first,
+            )
+        )
+        runs.append(
+            pd.DataFrame(
+                {
+                    "model": model_name,
+                    "N": model.n_beads,
+                    "shot": np.arange(first, first + len(speeds)),
+                    "kind": kind,
+                    "amplitude": np.arange(len(speeds)),
+                    "v0_left_m_s": result.v_left,
+                    "v0_right_m_s": result.v_right,
+                    "energy_drift": result.energy_drift,
+                    "dt_s": result.dt,
+                    "initial_energy_J": result.total_energy[:, 0],
+                    "dissipated_energy_J": result.dissipated_energy[:, -1],
+                }
+            )
+        )
+    return pd.concat(tables, ignore_index=True), pd.concat(runs, ignore_index=True)

@@ -1,0 +1,306 @@
+"""Closed forms of the paper: Nesterenko's solitary wave (Eq. 4-5), the Hertz
+two-sphere collision, and the ballistic estimate of the crossing delay (Eq. 6).
+
+SI units throughout; constants named ``*_us_N16`` are in microseconds N^(1/6).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.special import gamma
+
+from chain.materials import Material, require_positive
+
+#: Contact-time constant of a Hertz collision, t_c = HERTZ_TIME_CONSTANT * delta_max / v_rel.
+#: Exactly 2 * integral_0^1 dx / sqrt(1 - x^(5/2)) = 2 sqrt(pi) Gamma(7/5) / Gamma(9/10)
+#: = 2.943..., which Landau & Lifshitz round to 2.94 (the value printed in Eq. 6).
+HERTZ_TIME_CONSTANT = 2.0 * math.sqrt(math.pi) * gamma(1.4) / gamma(0.9)
+
+#: The rounded constant printed in the paper's Eq. 6.
+PAPER_TIME_CONSTANT = 2.94
+
+#: The numerical prefactor printed in the second line of Eq. 6.
+PAPER_CBAL_PREFACTOR = 0.7612
+
+
+def hertz_max_overlap(mass_a: float, mass_b: float, kappa: float, relative_speed: float) -> float:
+    """Largest overlap of a head-on Hertz collision, m.
+
+    Energy conservation, (1/2) mu v^2 = (2/5) kappa delta_max^(5/2), gives
+    delta_max = (5 mu v^2 / (4 kappa))^(2/5), with mu the reduced mass.
+
+    Parameters
+    ----------
+    mass_a, mass_b : float
+        Masses of the two bodies, kg (``math.inf`` for a fixed wall).
+    kappa : float
+        Contact stiffness, N/m^(3/2).
+    relative_speed : float
+        Approach speed before contact, m/s.
+    """
+    mu = _reduced_mass(mass_a, mass_b)
+    kappa = require_positive("kappa", kappa)
+    relative_speed = require_positive("relative_speed", relative_speed)
+    return (5.0 * mu * relative_speed**2 / (4.0 * kappa)) ** 0.4
+
+
+def hertz_contact_time(mass_a: float, mass_b: float, kappa: float, relative_speed: float) -> float:
+    """Exact duration of a head-on elastic Hertz collision, s.
+
+    From energy conservation the overlap obeys
+    (d delta/dt)^2 = v^2 - (4 kappa / (5 mu)) delta^(5/2), so
+    t_c = 2 int_0^delta_max d delta / sqrt(...) = 2.9432 delta_max / v
+    = 2.9432 (5 mu / (4 kappa))^(2/5) v^(-1/5), with mu = m_a m_b / (m_a + m_b).
+
+    The collision time used inside the paper's Eq. 6 differs in two ways:
+    it rounds the constant to 2.94 (-0.11 %), and it writes the mass factor as
+    5 pi rho R^3 / (3 kappa) = 5 m / (4 kappa), i.e. it uses mu = m, the reduced mass
+    of a bead hitting an immovable body, where two equal free beads have mu = m / 2.
+    The exact time for two equal free beads is therefore 2^(-2/5) = 0.758 times the
+    paper's; see :func:`ballistic_delay_constant_exact`.
+
+    Parameters
+    ----------
+    mass_a, mass_b : float
+        Masses of the two bodies, kg (``math.inf`` for a fixed wall).
+    kappa : float
+        Contact stiffness, N/m^(3/2).
+    relative_speed : float
+        Approach speed before contact, m/s.
+    """
+    delta_max = hertz_max_overlap(mass_a, mass_b, kappa, relative_speed)
+    return HERTZ_TIME_CONSTANT * delta_max / relative_speed
+
+
+def hertz_peak_force(mass_a: float, mass_b: float, kappa: float, relative_speed: float) -> float:
+    """Largest contact force of a head-on elastic Hertz collision, kappa delta_max^(3/2), N.
+
+    Parameters as in :func:`hertz_contact_time`.
+    """
+    return kappa * hertz_max_overlap(mass_a, mass_b, kappa, relative_speed) ** 1.5
+
+
+def nesterenko_speed_from_force(
+    peak_force: float | np.ndarray, material: Material, radius: float
+) -> float | np.ndarray:
+    """Solitary-wave speed from its peak force, Eq. 5 first form, m/s.
+
+    v = (6 / (5 pi rho))^(1/2) (F_m / (theta^2 R^2))^(1/6).
+
+    Parameters
+    ----------
+    peak_force : float or array
+        Peak contact force F_m, N.
+    material : Material
+        Bead material (rho, theta).
+    radius : float
+        Bead radius R, m.
+    """
+    radius = require_positive("radius", radius)
+    force = np.asarray(peak_force, dtype=float)
+    speed = (6.0 / (5.0 * math.pi * material.density)) ** 0.5 * (
+        force / (material.theta**2 * radius**2)
+    ) ** (1.0 / 6.0)
+    return float(speed) if np.ndim(speed) == 0 else speed
+
+
+def nesterenko_speed_from_velocity(
+    peak_bead_velocity: float | np.ndarray, material: Material
+) -> float | np.ndarray:
+    """Solitary-wave speed from the peak bead velocity, Eq. 5 second form, m/s.
+
+    v = (6 / (5 pi rho))^(2/5) (V_m / theta^2)^(1/5).
+
+    Parameters
+    ----------
+    peak_bead_velocity : float or array
+        Peak bead velocity V_m, m/s.
+    material : Material
+        Bead material (rho, theta).
+    """
+    velocity = np.asarray(peak_bead_velocity, dtype=float)
+    speed = (6.0 / (5.0 * math.pi * material.density)) ** 0.4 * (
+        velocity / material.theta**2
+    ) ** 0.2
+    return float(speed) if np.ndim(speed) == 0 else speed
+
+
+def bead_velocity_from_force(
+    peak_force: float | np.ndarray, material: Material, radius: float
+) -> float | np.ndarray:
+    """Peak bead velocity V_m of a solitary wave of peak force F_m, m/s.
+
+    Equating the two forms of Eq. 5:
+    V_m = (6 / (5 pi rho))^(1/2) theta^(1/3) R^(-5/3) F_m^(5/6).
+
+    Parameters
+    ----------
+    peak_force : float or array
+        Peak force F_m, N.
+    material : Material
+        Bead material.
+    radius : float
+        Bead radius, m.
+    """
+    radius = require_positive("radius", radius)
+    force = np.asarray(peak_force, dtype=float)
+    velocity = (
+        (6.0 / (5.0 * math.pi * material.density)) ** 0.5
+        * material.theta ** (1.0 / 3.0)
+        * radius ** (-5.0 / 3.0)
+        * force ** (5.0 / 6.0)
+    )
+    return float(velocity) if np.ndim(velocity) == 0 else velocity
+
+
+def force_from_bead_velocity(
+    peak_bead_velocity: float | np.ndarray, material: Material, radius: float
+) -> float | np.ndarray:
+    """Inverse of :func:`bead_velocity_from_force`: F_m from V_m, N.
+
+    Parameters
+    ----------
+    peak_bead_velocity : float or array
+        Peak bead velocity V_m, m/s.
+    material : Material
+        Bead material.
+    radius : float
+        Bead radius, m.
+    """
+    radius = require_positive("radius", radius)
+    velocity = np.asarray(peak_bead_velocity, dtype=float)
+    scale = (
+        (6.0 / (5.0 * math.pi * material.density)) ** 0.5
+        * material.theta ** (1.0 / 3.0)
+        * radius ** (-5.0 / 3.0)
+    )
+    force = (velocity / scale) ** 1.2
+    return float(force) if np.ndim(force) == 0 else force
+
+
+def pulse_half_width(peak_force: float | np.ndarray, material: Material, radius: float):
+    """The time scale tau of the cos^6 pulse, tau = R sqrt(10) / v (Eq. 4), s.
+
+    Parameters as in :func:`nesterenko_speed_from_force`.
+    """
+    return radius * math.sqrt(10.0) / nesterenko_speed_from_force(peak_force, material, radius)
+
+
+def solitary_wave_length(radius: float) -> float:
+    """Spatial extent of one hump of Eq. 4, pi R sqrt(10) (about five bead diameters), m.
+
+    Parameters
+    ----------
+    radius : float
+        Bead radius, m.
+    """
+    return math.pi * math.sqrt(10.0) * require_positive("radius", radius)
+
+
+def cos6_pulse(time, peak_force: float, arrival_time: float, tau: float) -> np.ndarray:
+    """Nesterenko's pulse F_m cos^6((t - T)/tau) on one hump, zero outside, N.
+
+    Parameters
+    ----------
+    time : array
+        Times, s.
+    peak_force : float
+        F_m, N.
+    arrival_time : float
+        T, s (time of the peak).
+    tau : float
+        Time scale, s; the hump spans |t - T| < pi tau / 2.
+    """
+    phase = (np.asarray(time, dtype=float) - arrival_time) / tau
+    return np.where(np.abs(phase) < math.pi / 2.0, peak_force * np.cos(phase) ** 6, 0.0)
+
+
+def ballistic_delay_constant_paper(material: Material, radius: float) -> float:
+    """C_bal exactly as printed in Eq. 6, in s N^(1/6).
+
+    C_bal = 0.7612 (5 pi rho / 6)^(1/2) (theta R^4)^(1/3); 49.74 us N^(1/6) for the
+    paper's 100C6 beads.
+
+    Parameters
+    ----------
+    material : Material
+        Bead material.
+    radius : float
+        Bead radius R, m.
+    """
+    radius = require_positive("radius", radius)
+    return (
+        PAPER_CBAL_PREFACTOR
+        * (5.0 * math.pi * material.density / 6.0) ** 0.5
+        * (material.theta * radius**4) ** (1.0 / 3.0)
+    )
+
+
+def ballistic_delay_constant_paper_first_line(material: Material, radius: float) -> float:
+    """C_bal from the first line of Eq. 6 (2.94, mu = m) with V_m(F_m) from Eq. 5, s N^(1/6).
+
+    A consistency check on the printed prefactor 0.7612: equal to
+    :func:`ballistic_delay_constant_paper` to the four digits printed.
+    """
+    mass = 4.0 / 3.0 * math.pi * radius**3 * material.density
+    kappa = 1.0 / (2.0 * material.theta * math.sqrt(2.0 / radius))
+    velocity_per_force = bead_velocity_from_force(1.0, material, radius)  # V_m at F_m = 1 N
+    time_scale = (5.0 * mass / (4.0 * kappa)) ** 0.4
+    return (
+        PAPER_TIME_CONSTANT
+        * time_scale
+        * velocity_per_force ** (-0.2)
+        * (1.0 - 2.0 ** (-0.2))
+    )
+
+
+def ballistic_delay_constant_exact(material: Material, radius: float) -> float:
+    """C_bal from the same ballistic argument with the exact Hertz contact time, s N^(1/6).
+
+    Delta = t_c(V_m) - t_c(2 V_m) for two equal free beads (reduced mass m/2, exact
+    constant 2.9432), with V_m(F_m) from Eq. 5 as in the paper. Differs from
+    :func:`ballistic_delay_constant_paper` by 2^(-2/5) * 2.9432/2.94 = 0.759 (see
+    :func:`hertz_contact_time`).
+
+    Parameters
+    ----------
+    material : Material
+        Bead material.
+    radius : float
+        Bead radius R, m.
+    """
+    radius = require_positive("radius", radius)
+    mass = 4.0 / 3.0 * math.pi * radius**3 * material.density
+    kappa = 1.0 / (2.0 * material.theta * math.sqrt(2.0 / radius))
+    velocity = bead_velocity_from_force(1.0, material, radius)  # F_m = 1 N
+    return hertz_contact_time(mass, mass, kappa, velocity) - hertz_contact_time(
+        mass, mass, kappa, 2.0 * velocity
+    )
+
+
+def ballistic_delay(peak_force, delay_constant: float):
+    """Delta = C F_m^(-1/6), in the units of ``delay_constant`` (s if C is in s N^(1/6)).
+
+    Parameters
+    ----------
+    peak_force : float or array
+        Incident peak force F_m, N.
+    delay_constant : float
+        C, s N^(1/6) (or us N^(1/6)).
+    """
+    return delay_constant * np.asarray(peak_force, dtype=float) ** (-1.0 / 6.0)
+
+
+def _reduced_mass(mass_a: float, mass_b: float) -> float:
+    # An infinite mass stands for a fixed wall.
+    mass_a = mass_a if mass_a == math.inf else require_positive("mass_a", mass_a)
+    mass_b = mass_b if mass_b == math.inf else require_positive("mass_b", mass_b)
+    if math.isinf(mass_a) and math.isinf(mass_b):
+        raise ValueError("mass_a and mass_b cannot both be infinite")
+    if math.isinf(mass_a):
+        return mass_b
+    if math.isinf(mass_b):
+        return mass_a
+    return mass_a * mass_b / (mass_a + mass_b)

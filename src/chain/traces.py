@@ -1,0 +1,205 @@
+"""The one trace format: sampled sensor forces of a set of shots, read/write/validate.
+
+A *trace table* is a pandas DataFrame in long form (one row per shot and sample),
+written to disk as CSV. Columns:
+
+=================  ======  ==========================================================
+column             type    meaning
+=================  ======  ==========================================================
+``source``         str     ``simulation`` or ``experiment``
+``model``          str     model name (``elastic``, ``viscoelastic``...) or dataset name
+``N``              int     number of beads in the chain
+``shot``           int     shot id, unique within the table
+``kind``           str     ``collision`` (both waves launched) or ``reference`` (left only)
+``amplitude``      int     index of the nominal launch amplitude (groups shots of one amplitude)
+``v0_left_m_s``    float   left launch speed (bead 1 or striker), m/s; NaN if unknown
+``v0_right_m_s``   float   right launch speed, m/s (0 for a reference shot); NaN if unknown
+``t_s``            float   time, s (any origin; only differences matter)
+``force_bead<n>_N`` float  force read at bead n, N, one column per sensor bead, in order
+=================  ======  ==========================================================
+
+Sensors are beads 1..N. The first sensor column is S1 (met first by the left-launched
+wave, LSTW), the last is S2. Within a shot, time is strictly increasing and evenly
+sampled.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+#: Columns every trace table has, in order, before the sensor columns.
+META_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "shot",
+    "kind",
+    "amplitude",
+    "v0_left_m_s",
+    "v0_right_m_s",
+    "t_s",
+)
+SOURCES = ("simulation", "experiment")
+KINDS = ("collision", "reference")
+_SENSOR_COLUMN = re.compile(r"^force_bead(\d+)_N$")
+#: CSV float format: 10 significant digits, ample for forces and times, and fixed bytes.
+FLOAT_FORMAT = "%.10g"
+
+
+class TraceFormatError(ValueError):
+    """A trace table or file does not follow the trace format; the message says where."""
+
+
+def sensor_column(bead: int) -> str:
+    """Column name of the force read at ``bead`` (1..N), N."""
+    return f"force_bead{int(bead)}_N"
+
+
+def sensor_beads(table: pd.DataFrame) -> list[int]:
+    """Bead numbers of the sensor columns of ``table``, in column order."""
+    beads = []
+    for column in table.columns:
+        match = _SENSOR_COLUMN.match(str(column))
+        if match:
+            beads.append(int(match.group(1)))
+    return beads
+
+
+def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataFrame:
+    """Check ``table`` against the trace format; return it with canonical dtypes.
+
+    Parameters
+    ----------
+    table : DataFrame
+        A trace table.
+    where : str
+        Name used in error messages (e.g. the file path).
+
+    Raises
+    ------
+    TraceFormatError
+        Naming the column, shot or value that is wrong.
+    """
+    missing = [c for c in META_COLUMNS if c not in table.columns]
+    if missing:
+        raise TraceFormatError(f"{where}: missing columns {missing}")
+    beads = sensor_beads(table)
+    if not beads:
+        raise TraceFormatError(f"{where}: no sensor column (force_bead<n>_N)")
+    extra = [c for c in table.columns if c not in META_COLUMNS and not _SENSOR_COLUMN.match(c)]
+    if extra:
+        raise TraceFormatError(f"{where}: unexpected columns {extra}")
+    if table.empty:
+        raise TraceFormatError(f"{where}: no rows")
+    bad_source = set(table["source"].unique()) - set(SOURCES)
+    if bad_source:
+        raise TraceFormatError(f"{where}: source must be one of {SOURCES}, got {bad_source}")
+    bad_kind = set(table["kind"].unique()) - set(KINDS)
+    if bad_kind:
+        raise TraceFormatError(f"{where}: kind must be one of {KINDS}, got {bad_kind}")
+    out = table.copy()
+    for column in ("N", "shot", "amplitude"):
+        values = pd.to_numeric(out[column], errors="coerce")
+        if values.isna().any() or (values != np.round(values)).any():
+            raise TraceFormatError(f"{where}: column {column} must hold integers")
+        out[column] = values.astype(np.int64)
+    n_values = out["N"].unique()
+    if len(n_values) != 1 or n_values[0] < 2:
+        raise TraceFormatError(f"{where}: column N must hold one chain size >= 2, got {n_values}")
+    n_beads = int(n_values[0])
+    outside = [b for b in beads if not 1 <= b <= n_beads]
+    if outside:
+        raise TraceFormatError(f"{where}: sensor beads {outside} outside the chain 1..{n_beads}")
+    for column in ("v0_left_m_s", "v0_right_m_s", "t_s", *map(sensor_column, beads)):
+        out[column] = pd.to_numeric(out[column], errors="coerce").astype(float)
+    for column in ("t_s", *map(sensor_column, beads)):
+        bad = ~np.isfinite(out[column].to_numpy())
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise TraceFormatError(
+                f"{where}: column {column} has a missing or non-finite value at data row {row + 1}"
+            )
+    for shot, group in out.groupby("shot", sort=False):
+        for column in ("source", "model", "kind", "amplitude"):
+            if group[column].nunique() != 1:
+                raise TraceFormatError(f"{where}: shot {shot} has several values of {column}")
+        time = group["t_s"].to_numpy()
+        if len(time) < 3:
+            raise TraceFormatError(f"{where}: shot {shot} has fewer than 3 samples")
+        step = np.diff(time)
+        if np.any(step <= 0):
+            raise TraceFormatError(f"{where}: shot {shot}: time is not strictly increasing")
+        if np.ptp(step) > 1e-3 * np.median(step):
+            raise TraceFormatError(f"{where}: shot {shot}: time is not evenly sampled")
+    return out
+
+
+def write_traces(table: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Validate ``table`` and write it as CSV, atomically (temporary file, then rename).
+
+    Parameters
+    ----------
+    table : DataFrame
+        A trace table.
+    path : path
+        Output CSV path; parent folders are created.
+    """
+    table = validate_traces(table, where=str(path))
+    write_csv_atomic(table, path)
+
+
+def read_traces(path: str | os.PathLike) -> pd.DataFrame:
+    """Read and validate a trace CSV written by :func:`write_traces`.
+
+    Parameters
+    ----------
+    path : path
+        CSV file.
+    """
+    path = Path(path)
+    try:
+        table = pd.read_csv(path)
+    except FileNotFoundError:
+        raise TraceFormatError(f"{path}: no such trace file") from None
+    except (pd.errors.EmptyDataError, pd.errors.ParserError) as error:
+        raise TraceFormatError(f"{path}: not a readable CSV trace file ({error})") from None
+    return validate_traces(table, where=str(path))
+
+
+def iter_shots(table: pd.DataFrame):
+    """Yield (shot id, shot metadata dict, time array s, {bead: force array N}) per shot."""
+    beads = sensor_beads(table)
+    for shot, group in table.groupby("shot", sort=True):
+        first = group.iloc[0]
+        meta = {c: first[c] for c in META_COLUMNS if c != "t_s"}
+        forces = {b: group[sensor_column(b)].to_numpy() for b in beads}
+        yield int(shot), meta, group["t_s"].to_numpy(), forces
+
+
+def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Write ``table`` as CSV to a temporary name beside ``path`` and rename it, so that
+    an interrupted write never leaves a partial file under the final name.
+
+    Parameters
+    ----------
+    table : DataFrame
+        Any table.
+    path : path
+        Destination; parent folders are created.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w", newline="") as stream:
+            table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
