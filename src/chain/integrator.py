@@ -46,8 +46,17 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
 
 @numba.njit(cache=True)
 def _derivatives(
-    u, v, masses, link_kind, link_stiffness, link_damping, wall_stiffness, wall_damping,
-    drag_rate, acc, link_force,
+    u,
+    v,
+    masses,
+    link_kind,
+    link_stiffness,
+    link_damping,
+    wall_stiffness,
+    wall_damping,
+    drag_rate,
+    acc,
+    link_force,
 ):
     """Accelerations into ``acc``, link forces into ``link_force``; returns
     (left wall force, right wall force, dissipated power)."""
@@ -105,13 +114,37 @@ def _potential_energy(u, link_kind, link_stiffness, wall_stiffness):
 
 @numba.njit(cache=True)
 def _record(
-    u, v, dissipated, masses, link_kind, link_stiffness, link_damping, wall_stiffness,
-    wall_damping, drag_rate, acc, link_force, sample, out_link_force, out_wall_force,
-    out_velocity, out_energy, out_momentum,
+    u,
+    v,
+    dissipated,
+    masses,
+    link_kind,
+    link_stiffness,
+    link_damping,
+    wall_stiffness,
+    wall_damping,
+    drag_rate,
+    acc,
+    link_force,
+    sample,
+    out_link_force,
+    out_wall_force,
+    out_velocity,
+    out_energy,
+    out_momentum,
 ):
     left, right, _ = _derivatives(
-        u, v, masses, link_kind, link_stiffness, link_damping, wall_stiffness, wall_damping,
-        drag_rate, acc, link_force,
+        u,
+        v,
+        masses,
+        link_kind,
+        link_stiffness,
+        link_damping,
+        wall_stiffness,
+        wall_damping,
+        drag_rate,
+        acc,
+        link_force,
     )
     kinetic = 0.0
     momentum = 0.0
@@ -132,9 +165,23 @@ def _record(
 
 @numba.njit(cache=True)
 def _integrate_one(
-    u, v, masses, link_kind, link_stiffness, link_damping, wall_stiffness, wall_damping,
-    drag_rate, dt, n_steps, record_every, out_link_force, out_wall_force, out_velocity,
-    out_energy, out_momentum,
+    u,
+    v,
+    masses,
+    link_kind,
+    link_stiffness,
+    link_damping,
+    wall_stiffness,
+    wall_damping,
+    drag_rate,
+    dt,
+    n_steps,
+    record_every,
+    out_link_force,
+    out_wall_force,
+    out_velocity,
+    out_energy,
+    out_momentum,
 ):
     """RK4 for one launch; ``u`` and ``v`` are updated in place. Returns the status
     and the step at which it was set."""
@@ -147,9 +194,24 @@ def _integrate_one(
     v_sum = np.empty(n)
     dissipated = 0.0
     _record(
-        u, v, dissipated, masses, link_kind, link_stiffness, link_damping, wall_stiffness,
-        wall_damping, drag_rate, acc, link_force, 0, out_link_force, out_wall_force,
-        out_velocity, out_energy, out_momentum,
+        u,
+        v,
+        dissipated,
+        masses,
+        link_kind,
+        link_stiffness,
+        link_damping,
+        wall_stiffness,
+        wall_damping,
+        drag_rate,
+        acc,
+        link_force,
+        0,
+        out_link_force,
+        out_wall_force,
+        out_velocity,
+        out_energy,
+        out_momentum,
     )
     half = 0.5 * dt
     sixth = dt / 6.0
@@ -163,8 +225,17 @@ def _integrate_one(
         # Classical RK4; the weighted slopes are summed as they come, so no stage is stored.
         for stage in range(4):
             _, _, power = _derivatives(
-                u_stage, v_stage, masses, link_kind, link_stiffness, link_damping,
-                wall_stiffness, wall_damping, drag_rate, acc, link_force,
+                u_stage,
+                v_stage,
+                masses,
+                link_kind,
+                link_stiffness,
+                link_damping,
+                wall_stiffness,
+                wall_damping,
+                drag_rate,
+                acc,
+                link_force,
             )
             weight = 1.0 if stage == 0 or stage == 3 else 2.0
             h = dt if stage == 2 else half
@@ -186,27 +257,71 @@ def _integrate_one(
             return _NOT_FINITE, step
         if step % record_every == 0:
             _record(
-                u, v, dissipated, masses, link_kind, link_stiffness, link_damping,
-                wall_stiffness, wall_damping, drag_rate, acc, link_force,
-                step // record_every, out_link_force, out_wall_force, out_velocity,
-                out_energy, out_momentum,
+                u,
+                v,
+                dissipated,
+                masses,
+                link_kind,
+                link_stiffness,
+                link_damping,
+                wall_stiffness,
+                wall_damping,
+                drag_rate,
+                acc,
+                link_force,
+                step // record_every,
+                out_link_force,
+                out_wall_force,
+                out_velocity,
+                out_energy,
+                out_momentum,
             )
     return _OK, n_steps
 
 
 @numba.njit(cache=True, parallel=True)
 def _integrate_batch(
-    u, v, masses, link_kind, link_stiffness, link_damping, wall_stiffness, wall_damping,
-    drag_rate, dt, n_steps, record_every, out_link_force, out_wall_force, out_velocity,
-    out_energy, out_momentum, out_status, out_fail_step,
+    u,
+    v,
+    masses,
+    link_kind,
+    link_stiffness,
+    link_damping,
+    wall_stiffness,
+    wall_damping,
+    drag_rate,
+    dt,
+    n_steps,
+    record_every,
+    out_link_force,
+    out_wall_force,
+    out_velocity,
+    out_energy,
+    out_momentum,
+    out_status,
+    out_fail_step,
 ):
     # Launches are independent: one thread each, so results do not depend on the
     # number of threads.
     for b in numba.prange(u.shape[0]):
         status, step = _integrate_one(
-            u[b], v[b], masses, link_kind, link_stiffness, link_damping, wall_stiffness,
-            wall_damping, drag_rate, dt, n_steps, record_every, out_link_force[b],
-            out_wall_force[b], out_velocity[b], out_energy[b], out_momentum[b],
+            u[b],
+            v[b],
+            masses,
+            link_kind,
+            link_stiffness,
+            link_damping,
+            wall_stiffness,
+            wall_damping,
+            drag_rate,
+            dt,
+            n_steps,
+            record_every,
+            out_link_force[b],
+            out_wall_force[b],
+            out_velocity[b],
+            out_energy[b],
+            out_momentum[b],
         )
         out_status[b] = status
         out_fail_step[b] = step
@@ -318,9 +433,24 @@ def integrate(
     link_damping[model.link_kind == SPRING] = 0.0
     wall_damping = 1.5 * model.wall_eta * model.wall_stiffness
     _integrate_batch(
-        displacement, velocity, model.masses, model.link_kind, model.link_stiffness,
-        link_damping, model.wall_stiffness, wall_damping, model.drag_rate, dt, n_steps,
-        record_every, link_force, wall_force, recorded_velocity, energy, momentum, status,
+        displacement,
+        velocity,
+        model.masses,
+        model.link_kind,
+        model.link_stiffness,
+        link_damping,
+        model.wall_stiffness,
+        wall_damping,
+        model.drag_rate,
+        dt,
+        n_steps,
+        record_every,
+        link_force,
+        wall_force,
+        recorded_velocity,
+        energy,
+        momentum,
+        status,
         fail_step,
     )
     if np.any(status != _OK):

@@ -65,9 +65,7 @@ class Material:
         require_positive(f"{self.name}: youngs_modulus", self.youngs_modulus)
         nu = self.poisson_ratio
         if not (isinstance(nu, int | float) and -1.0 < nu < 0.5):
-            raise ParameterError(
-                f"{self.name}: poisson_ratio must lie in (-1, 0.5), got {nu!r}"
-            )
+            raise ParameterError(f"{self.name}: poisson_ratio must lie in (-1, 0.5), got {nu!r}")
 
     @property
     def theta(self) -> float:

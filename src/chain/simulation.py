@@ -66,7 +66,9 @@ def default_time_step(model: ChainModel, max_launch_speed: float) -> float:
     for side, particle in ((0, 0), (1, model.n_particles - 1)):
         if model.wall_stiffness[side] > 0:
             contact = hertz_contact_time(
-                _moving_mass(model, particle), math.inf, model.wall_stiffness[side],
+                _moving_mass(model, particle),
+                math.inf,
+                model.wall_stiffness[side],
                 2 * max_launch_speed,
             )
             shortest = min(shortest, contact / STEPS_PER_CONTACT_TIME)
@@ -198,7 +200,11 @@ def simulate(
     record_interval = require_positive("record_interval", record_interval)
     record_every = max(1, round(record_interval / dt))
     raw = integrate(
-        model, velocities, duration, dt, record_every=record_every,
+        model,
+        velocities,
+        duration,
+        dt,
+        record_every=record_every,
         max_energy_drift=max_energy_drift,
     )
     return _bead_view(model, raw, left.copy(), right.copy())
@@ -208,7 +214,8 @@ def _bead_view(model: ChainModel, raw: RawTrajectory, left, right) -> Simulation
     masses = model.masses
     velocity = np.stack(
         [
-            (raw.velocity[:, :, a : b + 1] * masses[a : b + 1]).sum(axis=2) / masses[a : b + 1].sum()
+            (raw.velocity[:, :, a : b + 1] * masses[a : b + 1]).sum(axis=2)
+            / masses[a : b + 1].sum()
             for a, b in zip(model.bead_first, model.bead_last)
         ],
         axis=2,
@@ -343,13 +350,22 @@ def simulate_shots(
     runs = []
     for offset, (kind, right) in enumerate((("collision", speeds), ("reference", 0.0 * speeds))):
         result = simulate(
-            model, speeds, right, duration=duration, dt=dt, record_interval=record_interval,
+            model,
+            speeds,
+            right,
+            duration=duration,
+            dt=dt,
+            record_interval=record_interval,
             max_energy_drift=max_energy_drift,
         )
         first = offset * len(speeds)
         tables.append(
             trace_table(
-                result, sensor_beads, kind=kind, model_name=model_name, readout=readout,
+                result,
+                sensor_beads,
+                kind=kind,
+                model_name=model_name,
+                readout=readout,
                 first_shot=first,
             )
         )

@@ -248,12 +248,7 @@ def ballistic_delay_constant_paper_first_line(material: Material, radius: float)
     kappa = 1.0 / (2.0 * material.theta * math.sqrt(2.0 / radius))
     velocity_per_force = bead_velocity_from_force(1.0, material, radius)  # V_m at F_m = 1 N
     time_scale = (5.0 * mass / (4.0 * kappa)) ** 0.4
-    return (
-        PAPER_TIME_CONSTANT
-        * time_scale
-        * velocity_per_force ** (-0.2)
-        * (1.0 - 2.0 ** (-0.2))
-    )
+    return PAPER_TIME_CONSTANT * time_scale * velocity_per_force ** (-0.2) * (1.0 - 2.0 ** (-0.2))
 
 
 def ballistic_delay_constant_exact(material: Material, radius: float) -> float:
