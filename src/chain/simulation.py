@@ -166,6 +166,7 @@ def simulate(
     dt: float | None = None,
     record_interval: float = DEFAULT_RECORD_INTERVAL,
     max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
+    initial_displacement=None,
 ) -> SimulationResult:
     """Launch waves from both ends of ``model`` (a batch of launches) and integrate.
 
@@ -186,6 +187,10 @@ def simulate(
         Time between recorded samples, s; rounded to a whole number of steps.
     max_energy_drift : float
         Raise :class:`~chain.integrator.IntegrationError` above this relative drift.
+    initial_displacement : array (B, P) or (P,), optional
+        Particle displacements at t = 0, m (default 0: all particles just touching).
+        A positive value on the right striker (or negative on the left one) is an
+        initial gap, which delays that launch by gap / speed.
     """
     velocities = launch_velocities(model, v_left, v_right)
     left = np.atleast_1d(np.asarray(v_left, dtype=float))
@@ -205,6 +210,7 @@ def simulate(
         duration,
         dt,
         record_every=record_every,
+        initial_displacement=initial_displacement,
         max_energy_drift=max_energy_drift,
     )
     return _bead_view(model, raw, left.copy(), right.copy())
