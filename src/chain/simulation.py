@@ -182,9 +182,11 @@ def simulate(
     duration : float
         Simulated time, s.
     dt : float, optional
-        RK4 time step, s; default :func:`default_time_step` at the fastest launch.
+        RK4 time step, s; default :func:`default_time_step` at the fastest launch,
+        shortened so that ``record_interval`` is a whole number of steps.
     record_interval : float
-        Time between recorded samples, s; rounded to a whole number of steps.
+        Time between recorded samples, s; with an explicit ``dt`` it is rounded to a
+        whole number of steps.
     max_energy_drift : float
         Raise :class:`~chain.integrator.IntegrationError` above this relative drift.
     initial_displacement : array (B, P) or (P,), optional
@@ -199,10 +201,11 @@ def simulate(
     fastest = float(max(left.max(), right.max()))
     if fastest <= 0:
         raise ParameterError("v_left or v_right must be > 0 m/s in at least one launch")
-    if dt is None:
-        dt = default_time_step(model, fastest)
-    dt = require_positive("dt", dt)
     record_interval = require_positive("record_interval", record_interval)
+    if dt is None:
+        # Shrink the default step so that samples fall exactly every record_interval.
+        dt = record_interval / math.ceil(record_interval / default_time_step(model, fastest))
+    dt = require_positive("dt", dt)
     record_every = max(1, round(record_interval / dt))
     raw = integrate(
         model,
@@ -352,6 +355,7 @@ def simulate_shots(
         raise ParameterError(f"launch_speeds must be positive m/s values, got {launch_speeds!r}")
     if dt is None:
         dt = default_time_step(model, float(speeds.max()))
+        dt = record_interval / math.ceil(record_interval / dt)
     tables = []
     runs = []
     for offset, (kind, right) in enumerate((("collision", speeds), ("reference", 0.0 * speeds))):

@@ -1,0 +1,223 @@
+"""The ``hertzchain`` command: simulate a chain, analyse a trace file, print closed forms.
+
+Run ``hertzchain --help`` or ``hertzchain <command> --help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+from chain.integrator import IntegrationError
+from chain.materials import MATERIALS, ParameterError, contact_stiffness, get_material, sphere_mass
+from chain.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
+from chain.simulation import DEFAULT_RECORD_INTERVAL, simulate, trace_table
+from chain.traces import TraceFormatError, write_traces
+
+_DESCRIPTION = """\
+Solitary-wave collisions in a Hertzian chain of beads (Santibanez et al.).
+
+commands:
+  simulate   integrate Eq. 1 (optionally with Kuwabara-Kono dissipation, sensor beads,
+             strikers) for one launch and write a trace file (CSV, the project's trace
+             format: one row per sample, a force_bead<n>_N column per recorded bead)
+  analyse    fit the pulses of a trace file (cos^6 fits) and print them as CSV
+  theory     print the closed forms for a material: kappa, bead mass, C_bal (Eq. 6),
+             C_bal with the exact Hertz contact time, wave speed (Eq. 5)
+
+Beads are numbered 1..N as in the paper. Units: SI (m, s, m/s, N).
+Example:
+  hertzchain simulate -N 26 --speed 0.3 --kind collision --sensors 10 17 -o traces.csv
+"""
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="hertzchain",
+        description=_DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    commands = parser.add_subparsers(dest="command", required=True, metavar="command")
+
+    sim = commands.add_parser(
+        "simulate",
+        help="simulate one launch and write a trace file",
+        description="Simulate one launch of a chain of equal beads and write a trace CSV.",
+    )
+    sim.add_argument("-N", "--n-beads", type=int, required=True, help="number of beads N >= 2")
+    sim.add_argument(
+        "--speed", type=float, required=True, help="launch speed V0 of bead 1 (and N), m/s"
+    )
+    sim.add_argument(
+        "--kind",
+        choices=("collision", "reference"),
+        default="collision",
+        help="collision: +V0 on bead 1 and -V0 on bead N; reference: +V0 on bead 1 alone "
+        "(default: collision)",
+    )
+    sim.add_argument(
+        "--duration", type=float, default=2.6e-3, help="simulated time, s (default 2.6e-3)"
+    )
+    sim.add_argument("--dt", type=float, default=None, help="RK4 time step, s (default: automatic)")
+    sim.add_argument(
+        "--record-interval",
+        type=float,
+        default=DEFAULT_RECORD_INTERVAL,
+        help=f"time between recorded samples, s (default {DEFAULT_RECORD_INTERVAL:g})",
+    )
+    sim.add_argument(
+        "--sensors",
+        type=int,
+        nargs="+",
+        default=None,
+        help="beads to record, S1 first (default: every bead 1..N)",
+    )
+    sim.add_argument(
+        "--material",
+        choices=sorted(MATERIALS),
+        default="steel_100C6",
+        help="bead material (default steel_100C6, the paper's)",
+    )
+    sim.add_argument(
+        "--radius",
+        type=float,
+        default=PAPER_BEAD_RADIUS,
+        help=f"bead radius, m (default {PAPER_BEAD_RADIUS:g})",
+    )
+    sim.add_argument(
+        "--eta",
+        type=float,
+        default=0.0,
+        help="Kuwabara-Kono relaxation time, s (paper: 0.58e-6; default 0: Eq. 1)",
+    )
+    sim.add_argument(
+        "--sensor-beads",
+        action="store_true",
+        help="model the --sensors beads as split sensor beads (PCB 200B02, "
+        f"k_s = {PCB_200B02_STIFFNESS:g} N/m) and record their readings",
+    )
+    sim.add_argument(
+        "--striker-radius",
+        type=float,
+        default=None,
+        help="launch with spherical strikers of this radius, m (paper: 4e-3) "
+        "instead of giving V0 to the end beads",
+    )
+    sim.add_argument("--model-name", default="cli", help="value of the trace 'model' column")
+    sim.add_argument("-o", "--output", required=True, help="output trace CSV path")
+
+    analyse = commands.add_parser(
+        "analyse",
+        help="fit the pulses of a trace file",
+        description="Segment and fit every pulse of a trace CSV; print one row per pulse.",
+    )
+    analyse.add_argument("traces", help="trace CSV (hertzchain simulate output)")
+    analyse.add_argument(
+        "--estimator",
+        default="fit_full",
+        help="fit_full (paper: cos^6 fit on |t-T| < tau), peak or fit_rise",
+    )
+    analyse.add_argument("-o", "--output", default=None, help="write the table here (CSV)")
+
+    theory = commands.add_parser(
+        "theory",
+        help="print closed forms for a material",
+        description="Print kappa, bead mass, C_bal (Eq. 6 as printed and with the exact "
+        "Hertz contact time) and the Eq. 5 wave speed at a given force, as JSON.",
+    )
+    theory.add_argument("--material", choices=sorted(MATERIALS), default="steel_100C6")
+    theory.add_argument("--radius", type=float, default=PAPER_BEAD_RADIUS, help="bead radius, m")
+    theory.add_argument(
+        "--force", type=float, default=100.0, help="peak force F_m for the wave speed, N"
+    )
+    return parser
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    material = get_material(args.material)
+    beads = args.sensors if args.sensors is not None else list(range(1, args.n_beads + 1))
+    model = uniform_chain(
+        args.n_beads,
+        material,
+        args.radius,
+        args.eta,
+        sensor_beads=beads if args.sensor_beads else (),
+        striker_radius=args.striker_radius,
+    )
+    v_right = args.speed if args.kind == "collision" else 0.0
+    result = simulate(
+        model,
+        args.speed,
+        v_right,
+        duration=args.duration,
+        dt=args.dt,
+        record_interval=args.record_interval,
+    )
+    table = trace_table(
+        result,
+        beads,
+        kind=args.kind,
+        model_name=args.model_name,
+        readout="sensor" if args.sensor_beads else "felt",
+    )
+    write_traces(table, args.output)
+    print(
+        f"wrote {args.output}: N={args.n_beads}, {len(result.time)} samples, "
+        f"dt={result.dt:.3e} s, energy drift {result.energy_drift.max():.2e}",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def _analyse(args: argparse.Namespace) -> int:
+    from chain.pulses import pulse_table  # analysis is imported only when asked for
+    from chain.traces import read_traces
+
+    table = pulse_table(read_traces(args.traces), estimators=(args.estimator,))
+    if args.output:
+        from chain.traces import write_csv_atomic
+
+        write_csv_atomic(table, args.output)
+    else:
+        table.to_csv(sys.stdout, index=False, float_format="%.6g")
+    return 0
+
+
+def _theory(args: argparse.Namespace) -> int:
+    from chain import theory
+
+    material = get_material(args.material)
+    radius = args.radius
+    mass = sphere_mass(material, radius)
+    kappa = contact_stiffness(material, radius, material, radius)
+    values = {
+        "material": material.name,
+        "radius_m": radius,
+        "kappa_N_m1_5": kappa,
+        "bead_mass_kg": mass,
+        "C_bal_paper_us_N16": theory.ballistic_delay_constant_paper(material, radius) * 1e6,
+        "C_bal_exact_us_N16": theory.ballistic_delay_constant_exact(material, radius) * 1e6,
+        "F_m_N": args.force,
+        "wave_speed_m_s": theory.nesterenko_speed_from_force(args.force, material, radius),
+        "bead_velocity_m_s": theory.bead_velocity_from_force(args.force, material, radius),
+        "tau_s": theory.pulse_half_width(args.force, material, radius),
+    }
+    print(json.dumps(values, indent=2))
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``hertzchain`` console script; returns the exit status."""
+    args = _build_parser().parse_args(argv)
+    handlers = {"simulate": _simulate, "analyse": _analyse, "theory": _theory}
+    try:
+        return handlers[args.command](args)
+    except (ParameterError, TraceFormatError, IntegrationError, FileNotFoundError) as error:
+        print(f"hertzchain {args.command}: error: {error}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
