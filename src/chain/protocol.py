@@ -1,0 +1,232 @@
+"""The paper's acceptance protocol: keep a collision only if the two waves matched.
+
+Sec. IV: "When the incident waves registered by the sensors had amplitude difference no
+greater than 5 %, it is considered that solitary waves have crossed at the middle of the
+chain ... Data for which this condition is not fulfilled are not retained."
+
+:func:`select_shots` applies it to the rows of ``pulses.csv``
+(:func:`chain.pulses.pulse_table`): a collision shot is kept when the incident
+amplitudes F_L (LSTW at S1) and F_R (RSTW at S2) satisfy
+
+    mismatch = |F_L - F_R| / ((F_L + F_R) / 2) <= tolerance,
+
+a reference shot when its pulses were fitted at every sensor. A shot whose pulse was
+not detected, or whose fit failed, is a rejected row with the reason, not an error.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from chain.materials import ParameterError
+
+#: The paper's amplitude-match tolerance (5 %).
+DEFAULT_TOLERANCE = 0.05
+
+#: Columns of the selection table, in order.
+SELECTION_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "shot",
+    "kind",
+    "amplitude",
+    "F_left_N",
+    "F_right_N",
+    "mismatch",
+    "kept",
+    "reason",
+)
+
+_KEY = ["source", "model", "N", "shot"]
+_PULSE_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "shot",
+    "kind",
+    "amplitude",
+    "sensor",
+    "role",
+    "estimator",
+    "F_m_N",
+    "ok",
+)
+
+
+def amplitude_mismatch(force_left_N, force_right_N):
+    """Relative difference of two amplitudes, |F_L - F_R| / mean (dimensionless).
+
+    Parameters
+    ----------
+    force_left_N, force_right_N : float or array
+        Incident amplitudes of the left- and right-launched waves, N.
+    """
+    left = np.asarray(force_left_N, dtype=float)
+    right = np.asarray(force_right_N, dtype=float)
+    return np.abs(left - right) / (0.5 * (left + right))
+
+
+def select_shots(
+    pulses: pd.DataFrame,
+    tolerance: float = DEFAULT_TOLERANCE,
+    *,
+    estimator: str = "fit_full",
+    shots: pd.DataFrame | None = None,
+) -> pd.DataFrame:
+    """Apply the paper's acceptance filter to every shot of a pulse table.
+
+    Parameters
+    ----------
+    pulses : DataFrame
+        Rows of ``pulses.csv`` (columns of :func:`chain.pulses.pulse_table`; needed:
+        source, model, N, shot, kind, amplitude, sensor, role, estimator, F_m_N, ok,
+        and reason when present).
+    tolerance : float
+        Largest accepted amplitude mismatch, as a fraction (0.05 = 5 %).
+    estimator : str
+        Estimator whose amplitudes are compared (the paper's: ``fit_full``).
+    shots : DataFrame, optional
+        The shots that were recorded (any table with source, model, N, shot, kind,
+        amplitude, e.g. the trace table): a shot without any row in ``pulses`` becomes
+        a rejected row "no pulse detected".
+
+    Returns
+    -------
+    DataFrame
+        One row per shot, columns :data:`SELECTION_COLUMNS`: F_left_N (incident LSTW
+        at S1; for a reference, its amplitude at S1), F_right_N (incident RSTW at S2;
+        NaN for a reference), mismatch (fraction; NaN when not computed), kept (bool),
+        reason (why kept or rejected, e.g. "amplitude mismatch 7.2% > 5%").
+    """
+    if isinstance(tolerance, bool) or not isinstance(tolerance, int | float):
+        raise ParameterError(f"tolerance must be a number, got {tolerance!r}")
+    if not (math.isfinite(tolerance) and tolerance >= 0):
+        raise ParameterError(f"tolerance must be a fraction >= 0, got {tolerance!r}")
+    missing = [c for c in _PULSE_COLUMNS if c not in pulses.columns]
+    if missing:
+        raise ParameterError(f"pulses: missing columns {missing}")
+    table = pulses[pulses["estimator"] == estimator]
+    if table.empty and not pulses.empty:
+        known = sorted(pulses["estimator"].unique())
+        raise ParameterError(f"pulses: no rows for estimator {estimator!r}; present: {known}")
+
+    rows = []
+    seen = set()
+    for key, group in table.groupby(_KEY, sort=False):
+        seen.add(tuple(key))
+        first = group.iloc[0]
+        base = dict(zip(_KEY, key), kind=first["kind"], amplitude=int(first["amplitude"]))
+        if first["kind"] == "collision":
+            rows.append({**base, **_judge_collision(group, tolerance)})
+        else:
+            rows.append({**base, **_judge_reference(group)})
+    if shots is not None:
+        absent = shots.drop_duplicates(_KEY)
+        for record in absent.itertuples(index=False):
+            key = tuple(getattr(record, c) for c in _KEY)
+            if key in seen:
+                continue
+            seen.add(key)
+            rows.append(
+                {
+                    **dict(zip(_KEY, key)),
+                    "kind": record.kind,
+                    "amplitude": int(record.amplitude),
+                    **_rejected("no pulse detected (no pulse rows for this shot)"),
+                }
+            )
+    selection = pd.DataFrame(rows, columns=SELECTION_COLUMNS)
+    selection["kept"] = selection["kept"].astype(bool)
+    return selection.sort_values(_KEY, kind="stable").reset_index(drop=True)
+
+
+def _rejected(reason: str, left=math.nan, right=math.nan, mismatch=math.nan) -> dict:
+    return {
+        "F_left_N": left,
+        "F_right_N": right,
+        "mismatch": mismatch,
+        "kept": False,
+        "reason": reason,
+    }
+
+
+def _pulse(group: pd.DataFrame, sensor: str, role: str):
+    """The amplitude of one pulse, or (None, why it is missing)."""
+    rows = group[(group["sensor"] == sensor) & (group["role"] == role)]
+    label = f"{role} pulse at {sensor}"
+    if rows.empty:
+        return None, f"no pulse detected ({label}: no row)"
+    row = rows.iloc[0]
+    if not bool(row["ok"]):
+        reason = str(row["reason"]) if "reason" in row and isinstance(row["reason"], str) else ""
+        return None, f"{reason or 'fit failed'} ({label})"
+    force = float(row["F_m_N"])
+    if not (math.isfinite(force) and force > 0):
+        return None, f"no positive amplitude ({label}: F_m = {force!r} N)"
+    return force, ""
+
+
+def _judge_collision(group: pd.DataFrame, tolerance: float) -> dict:
+    left, why_left = _pulse(group, "S1", "incident")
+    right, why_right = _pulse(group, "S2", "incident")
+    if left is None or right is None:
+        why = "; ".join(w for w in (why_left, why_right) if w)
+        return _rejected(why, left if left else math.nan, right if right else math.nan)
+    mismatch = float(amplitude_mismatch(left, right))
+    # A hair of slack so that a mismatch equal to the tolerance is not lost to rounding.
+    kept = mismatch <= tolerance * (1 + 1e-12)
+    relation = "<=" if kept else ">"
+    reason = f"amplitude mismatch {100 * mismatch:.1f}% {relation} {100 * tolerance:g}%"
+    return {
+        "F_left_N": left,
+        "F_right_N": right,
+        "mismatch": mismatch,
+        "kept": kept,
+        "reason": ("kept: " if kept else "") + reason,
+    }
+
+
+def _judge_reference(group: pd.DataFrame) -> dict:
+    sensors = sorted(group["sensor"].unique()) or ["S1"]
+    forces = {}
+    problems = []
+    for sensor in sensors:
+        force, why = _pulse(group, sensor, "reference")
+        forces[sensor] = force
+        if force is None:
+            problems.append(why)
+    left = forces.get("S1") or math.nan
+    if problems:
+        return _rejected("; ".join(problems), left)
+    return {
+        "F_left_N": left,
+        "F_right_N": math.nan,
+        "mismatch": math.nan,
+        "kept": True,
+        "reason": "kept: reference pulse fitted at " + " and ".join(sensors),
+    }
+
+
+def keep_selected(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
+    """Rows of ``table`` whose shot was not rejected by ``selection``.
+
+    Parameters
+    ----------
+    table : DataFrame
+        Any table with source, model, N, shot (traces, pulses, delays...).
+    selection : DataFrame or None
+        Output of :func:`select_shots`; None keeps everything. Shots absent from the
+        selection are kept.
+    """
+    if selection is None:
+        return table
+    rejected = selection.loc[~selection["kept"].astype(bool), _KEY]
+    if rejected.empty:
+        return table
+    keys = pd.MultiIndex.from_frame(table[_KEY].astype({"N": "int64", "shot": "int64"}))
+    drop = pd.MultiIndex.from_frame(rejected.astype({"N": "int64", "shot": "int64"}))
+    return table[~keys.isin(drop)]
