@@ -1,0 +1,576 @@
+"""Pulse analysis of sampled force signals: baseline, segmentation, amplitude and timing.
+
+A sensor signal of a collision shot holds two main pulses (the incident wave, then the
+wave that crossed it); a reference shot holds one. :func:`find_pulses` locates them and
+splits neighbours at the minimum between them; :func:`fit_pulse` measures one pulse
+with one of the :data:`ESTIMATORS`:
+
+``fit_full`` (the paper's method)
+    least squares of F_m cos^6((t - T)/tau) on -tau < t - T < tau, the window
+    re-selected from the new (T, tau) until the set of samples no longer changes;
+``peak``
+    parabolic interpolation of the maximum: the vertex of the least-squares parabola
+    through the samples within tau/4 of the largest one (the 3-point parabola when the
+    pulse spans few samples; more samples average the noise over the flat top, where
+    cos^6 is a parabola to 0.2 %); tau from the full width at half maximum;
+``fit_rise``
+    the same fit as ``fit_full`` on the rising half only, -tau < t - T <= 0 (blind to
+    whatever trails the peak).
+
+A measurement that cannot be made gives a :class:`PulseFit` with ``ok=False`` and a
+``reason``, never an exception. :func:`pulse_table` turns a trace table
+(:mod:`chain.traces`) into the rows of ``pulses.csv`` (see ``docs/interfaces.md``).
+
+SI units inside; table columns carry their unit.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import OptimizeWarning, curve_fit
+from scipy.signal import find_peaks, peak_widths, savgol_coeffs, savgol_filter
+
+from chain.materials import ParameterError
+from chain.traces import iter_shots, sensor_beads
+
+#: Names of the amplitude/arrival-time estimators, the paper's first.
+ESTIMATORS = ("fit_full", "peak", "fit_rise")
+
+#: FWHM of cos^6((t - T)/tau) divided by tau: 2 arccos(2^(-1/6)) = 0.9416.
+COS6_FWHM_PER_TAU = 2.0 * math.acos(2.0 ** (-1.0 / 6.0))
+
+#: Default prominence of a main pulse, as a fraction of the largest pulse: main pulses
+#: are of similar size, noise bumps and secondary waves are far smaller.
+DEFAULT_REL_PROMINENCE = 0.2
+
+#: Default detection threshold in units of the noise standard deviation: the largest
+#: of ~10^4 Gaussian samples stays below 5 sigma.
+DEFAULT_MIN_SNR = 8.0
+
+#: Fewest samples a fit window may hold (three parameters plus a few degrees of freedom).
+MIN_FIT_SAMPLES = 6
+
+#: Fits of a window cycle that agree within this many standard errors count as stable.
+CYCLE_TOLERANCE = 2.0
+
+#: Longest sequence of window re-selections before a fit is declared unstable.
+MAX_WINDOW_ITERATIONS = 30
+
+#: A segment reaches this many FWHM beyond a pulse's peak on its free sides
+#: (the cos^6 hump ends at pi tau / 2 = 1.67 FWHM from the peak).
+SEGMENT_HALF_WIDTH_FWHM = 2.0
+
+#: Fraction of the largest excursion below which a sample counts as "quiet" (baseline).
+QUIET_FRACTION = 0.05
+
+
+@dataclass(frozen=True)
+class PulseFit:
+    """Amplitude and timing of one pulse.
+
+    Attributes
+    ----------
+    peak_force : float
+        F_m, N, above the baseline.
+    arrival_time : float
+        T, time of the peak, s (same origin as the input times).
+    tau : float
+        Time scale of F_m cos^6((t - T)/tau), s.
+    peak_force_stderr, arrival_time_stderr, tau_stderr : float
+        Standard errors, N, s, s (from the fit covariance scaled by the residual
+        variance, or from the noise level for ``peak``); NaN when unknown.
+    ok : bool
+        False when the measurement failed; the values are then NaN.
+    reason : str
+        Why it failed ("" when ok).
+    n_samples : int
+        Samples used (final fit window, or the smoothing window for ``peak``).
+    """
+
+    peak_force: float
+    arrival_time: float
+    tau: float
+    peak_force_stderr: float
+    arrival_time_stderr: float
+    tau_stderr: float
+    ok: bool = True
+    reason: str = ""
+    n_samples: int = 0
+
+    @classmethod
+    def failed(cls, reason: str) -> PulseFit:
+        """A flagged result with NaN values."""
+        nan = math.nan
+        return cls(nan, nan, nan, nan, nan, nan, ok=False, reason=reason, n_samples=0)
+
+
+@dataclass(frozen=True)
+class PulseSegment:
+    """Index range [start, stop) of one pulse in a signal, and the index of its peak."""
+
+    start: int
+    stop: int
+    peak: int
+
+    @property
+    def slice(self) -> slice:
+        return slice(self.start, self.stop)
+
+
+def cos6_model(time_s, peak_force_N: float, arrival_time_s: float, tau_s: float):
+    """F_m cos^6((t - T)/tau) without the cut-off outside the hump (fits use |t-T| < tau), N.
+
+    Parameters
+    ----------
+    time_s : array
+        Times, s.
+    peak_force_N, arrival_time_s, tau_s : float
+        F_m (N), T (s), tau (s).
+    """
+    return peak_force_N * np.cos((np.asarray(time_s) - arrival_time_s) / tau_s) ** 6
+
+
+def _cos6_jacobian(time_s, peak_force_N, arrival_time_s, tau_s):
+    phase = (time_s - arrival_time_s) / tau_s
+    c, s = np.cos(phase), np.sin(phase)
+    slope = 6.0 * peak_force_N * c**5 * s  # = -dF/dphase
+    return np.column_stack((c**6, slope / tau_s, slope * phase / tau_s))
+
+
+def estimate_baseline(time_s, force_N) -> tuple[float, float]:
+    """Baseline offset and noise level of a signal, from its pre-pulse part.
+
+    The pre-pulse part ends well before the foot of the first pulse: the first sample
+    above half the largest excursion is found, then the last quiet sample before it
+    (below :data:`QUIET_FRACTION` of the excursion); the rise between the two spans
+    0.45 tau for a cos^6 pulse and the foot below it 0.65 tau, so the part is cut two
+    rises earlier. With fewer than 8 samples there, all quiet samples of the signal
+    are used instead.
+
+    Parameters
+    ----------
+    time_s : array
+        Times, s (unused; kept for a uniform signature).
+    force_N : array
+        Signal, N.
+
+    Returns
+    -------
+    baseline_N : float
+        Median of the pre-pulse part, N.
+    noise_N : float
+        Its standard deviation (1.4826 x median absolute deviation), N.
+    """
+    force = np.asarray(force_N, dtype=float)
+    rough = float(np.median(force))
+    excursion = float(force.max()) - rough
+    quiet = force
+    if excursion > 0:
+        half = np.flatnonzero(force - rough > 0.5 * excursion)
+        first_half = int(half[0])
+        below = np.flatnonzero(force[:first_half] - rough <= QUIET_FRACTION * excursion)
+        if below.size:
+            foot = int(below[-1])
+            end = foot - 2 * (first_half - foot)
+            if end >= 8:
+                quiet = force[:end]
+            else:
+                quiet = force[np.abs(force - rough) <= QUIET_FRACTION * excursion]
+    baseline = float(np.median(quiet))
+    noise = 1.4826 * float(np.median(np.abs(quiet - baseline)))
+    return baseline, noise
+
+
+def find_pulses(
+    time_s,
+    force_N,
+    max_pulses: int = 2,
+    *,
+    baseline_N: float | None = None,
+    noise_N: float | None = None,
+    rel_prominence: float = DEFAULT_REL_PROMINENCE,
+    min_snr: float = DEFAULT_MIN_SNR,
+    min_height_N: float = 0.0,
+) -> list[PulseSegment]:
+    """The main pulses of a signal, in time order, as index ranges.
+
+    Peaks are found with :func:`scipy.signal.find_peaks`; a main pulse has a prominence
+    of at least ``rel_prominence`` times the largest excursion and a height above
+    ``max(min_snr * noise_N, min_height_N)``. The ``max_pulses`` most prominent are
+    kept. Neighbours are split at the minimum of the signal between their peaks; a
+    free side extends :data:`SEGMENT_HALF_WIDTH_FWHM` widths at half maximum.
+
+    Parameters
+    ----------
+    time_s : array
+        Times, s, increasing.
+    force_N : array
+        Signal, N.
+    max_pulses : int
+        Most pulses to return.
+    baseline_N, noise_N : float, optional
+        Baseline offset and noise standard deviation, N; estimated by
+        :func:`estimate_baseline` when not given.
+    rel_prominence : float
+        Least prominence of a pulse, as a fraction of the largest excursion.
+    min_snr : float
+        Least height of a pulse above the baseline, in noise standard deviations.
+    min_height_N : float
+        Least height above the baseline, N.
+
+    Returns
+    -------
+    list of PulseSegment
+        Empty when no pulse clears the thresholds.
+    """
+    time, force = _as_signal(time_s, force_N)
+    if baseline_N is None or noise_N is None:
+        estimated = estimate_baseline(time, force)
+        baseline_N = estimated[0] if baseline_N is None else baseline_N
+        noise_N = estimated[1] if noise_N is None else noise_N
+    signal = force - baseline_N
+    largest = float(signal.max())
+    threshold = max(min_snr * noise_N, min_height_N)
+    if not largest > threshold or largest <= 0:
+        return []
+    peaks, properties = find_peaks(signal, height=threshold, prominence=rel_prominence * largest)
+    if peaks.size == 0:
+        return []
+    strongest = np.argsort(properties["prominences"])[::-1][:max_pulses]
+    peaks = np.sort(peaks[strongest])
+    widths = peak_widths(signal, peaks, rel_height=0.5)[0]
+    segments = []
+    for i, peak in enumerate(peaks):
+        reach = math.ceil(SEGMENT_HALF_WIDTH_FWHM * float(widths[i]))
+        start = max(0, peak - reach)
+        stop = min(len(signal), peak + reach + 1)
+        if i > 0:
+            start = max(start, peaks[i - 1] + int(np.argmin(signal[peaks[i - 1] : peak])))
+        if i + 1 < len(peaks):
+            stop = min(stop, peak + int(np.argmin(signal[peak : peaks[i + 1]])) + 1)
+        segments.append(PulseSegment(int(start), int(stop), int(peak)))
+    return segments
+
+
+def fit_pulse(
+    time_s,
+    force_N,
+    estimator: str = "fit_full",
+    *,
+    baseline_N: float | None = None,
+    noise_N: float | None = None,
+) -> PulseFit:
+    """Amplitude, arrival time and width of the largest pulse of a signal.
+
+    Pass one segment of :func:`find_pulses` (``time_s[seg.slice]``...) to measure a
+    pulse that has neighbours, with the baseline of the whole signal.
+
+    Parameters
+    ----------
+    time_s : array
+        Times, s, increasing and evenly sampled.
+    force_N : array
+        Signal, N.
+    estimator : {"fit_full", "peak", "fit_rise"}
+        See the module docstring.
+    baseline_N, noise_N : float, optional
+        Baseline offset and noise standard deviation, N; estimated from the signal by
+        :func:`estimate_baseline` when not given.
+
+    Returns
+    -------
+    PulseFit
+        ``ok=False`` with a reason when the pulse cannot be measured.
+    """
+    if estimator not in ESTIMATORS:
+        raise ParameterError(f"estimator must be one of {ESTIMATORS}, got {estimator!r}")
+    time, force = _as_signal(time_s, force_N)
+    if len(time) < MIN_FIT_SAMPLES:
+        return PulseFit.failed(f"fewer than {MIN_FIT_SAMPLES} samples")
+    if not (np.all(np.isfinite(time)) and np.all(np.isfinite(force))):
+        return PulseFit.failed("non-finite samples")
+    if baseline_N is None or noise_N is None:
+        estimated = estimate_baseline(time, force)
+        baseline_N = estimated[0] if baseline_N is None else baseline_N
+        noise_N = estimated[1] if noise_N is None else noise_N
+    signal = force - baseline_N
+    peak = int(np.argmax(signal))
+    if not signal[peak] > 0:
+        return PulseFit.failed("no positive pulse")
+    half_width = _half_width_samples(signal, peak)
+    if not half_width > 0:
+        return PulseFit.failed("pulse width not measurable")
+    dt = float(np.median(np.diff(time)))
+    tau0 = half_width * dt / COS6_FWHM_PER_TAU
+    if estimator == "peak":
+        return _peak_estimate(time, signal, peak, tau0, noise_N)
+    return _iterated_fit(time, signal, peak, tau0, rising_only=estimator == "fit_rise")
+
+
+def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
+    time = np.asarray(time_s, dtype=float)
+    force = np.asarray(force_N, dtype=float)
+    if time.ndim != 1 or time.shape != force.shape:
+        raise ParameterError(
+            f"time_s and force_N must be 1-D arrays of one length, got {time.shape} "
+            f"and {force.shape}"
+        )
+    if time.size == 0:
+        raise ParameterError("time_s and force_N are empty")
+    return time, force
+
+
+def _half_width_samples(signal: np.ndarray, peak: int) -> float:
+    # Full width at half maximum, in samples, interpolated between samples.
+    return float(peak_widths(signal, [peak], rel_height=0.5)[0][0])
+
+
+def _window(time, arrival, tau, rising_only: bool) -> tuple[int, int]:
+    start = int(np.searchsorted(time, arrival - tau, side="right"))
+    if rising_only:
+        return start, int(np.searchsorted(time, arrival, side="right"))
+    return start, int(np.searchsorted(time, arrival + tau, side="left"))
+
+
+def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
+    """Fit F_m cos^6 on the window the parameters define, until the window is stable.
+
+    With noise the window map can cycle between windows a sample apart; the cycle is
+    accepted as stable when its fits agree within :data:`CYCLE_TOLERANCE` standard
+    errors (the window no longer moves the estimate beyond the noise), and the fit on
+    the most samples is returned.
+    """
+    params = np.array([signal[peak], time[peak], tau0])
+    windows = [_window(time, params[1], params[2], rising_only)]
+    fits = []
+    for _ in range(MAX_WINDOW_ITERATIONS):
+        start, stop = windows[-1]
+        if stop - start < MIN_FIT_SAMPLES:
+            return PulseFit.failed(f"fit window holds {max(stop - start, 0)} samples")
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", OptimizeWarning)
+                params, covariance = curve_fit(
+                    cos6_model,
+                    time[start:stop],
+                    signal[start:stop],
+                    p0=params,
+                    jac=_cos6_jacobian,
+                    maxfev=2000,
+                )
+        except (RuntimeError, OptimizeWarning, ValueError) as error:
+            return PulseFit.failed(f"fit did not converge ({error})")
+        force, arrival, tau = params
+        if not (force > 0 and tau > 0 and time[0] <= arrival <= time[-1]):
+            return PulseFit.failed("fit left the segment")
+        if tau > time[-1] - time[0]:
+            return PulseFit.failed("fitted tau longer than the segment")
+        errors = np.sqrt(np.diag(covariance))
+        if not np.all(np.isfinite(errors)):
+            return PulseFit.failed("covariance not estimable")
+        fits.append(PulseFit(*map(float, (force, arrival, tau, *errors)), n_samples=stop - start))
+        window = _window(time, arrival, tau, rising_only)
+        if window == windows[-1]:
+            return fits[-1]
+        if window in windows:
+            cycle = fits[windows.index(window) :]
+            values = np.array([(f.peak_force, f.arrival_time, f.tau) for f in cycle])
+            errors = np.array(
+                [(f.peak_force_stderr, f.arrival_time_stderr, f.tau_stderr) for f in cycle]
+            )
+            if np.all(np.ptp(values, axis=0) <= CYCLE_TOLERANCE * errors.max(axis=0)):
+                return max(cycle, key=lambda f: f.n_samples)
+            return PulseFit.failed("fit window oscillates")
+        windows.append(window)
+    return PulseFit.failed(f"fit window not stable after {MAX_WINDOW_ITERATIONS} iterations")
+
+
+def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
+    """Vertex of the least-squares parabola through the samples around the maximum."""
+    dt = float(np.median(np.diff(time)))
+    # A parabola over tau/2 (quadratic Savitzky-Golay coefficients) averages the noise
+    # over the top of the pulse, where cos^6 is still a parabola to 0.2 %; when the
+    # pulse spans few samples this is the 3-point parabolic interpolation.
+    length = max(round(0.5 * tau0 / dt) | 1, 3)
+    half = length // 2
+    smooth = savgol_filter(signal, length, 2) if len(signal) > length else signal
+    lo, hi = max(peak - half, half), min(peak + half + 1, len(signal) - half)
+    if hi <= lo:
+        return PulseFit.failed("peak at the segment edge")
+    centre = lo + int(np.argmax(smooth[lo:hi]))
+    coefficients = [savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2)]
+    for _ in range(2):  # re-centre once on the sample nearest the vertex
+        around = signal[centre - half : centre + half + 1]
+        value, slope, curvature = (float(np.dot(c, around)) for c in coefficients)
+        if not curvature < 0:
+            return PulseFit.failed("peak not a maximum")
+        offset = -slope / curvature  # s
+        step = round(offset / dt)
+        if step == 0 or not half <= centre + step < len(signal) - half:
+            break
+        centre += step
+    if abs(offset) > half * dt:
+        return PulseFit.failed("peak vertex outside the fitted samples")
+    peak_value = value - 0.5 * slope**2 / curvature
+    tau = _half_width_samples(signal, int(np.argmax(signal))) * dt / COS6_FWHM_PER_TAU
+    # Noise propagation: the value carries the filter's noise gain; the vertex moves by
+    # the slope's noise over the curvature; each half-maximum crossing moves by
+    # noise / |slope|, and |dF/dt| of cos^6 at half maximum is 1.527 F_m / tau.
+    value_error = noise * math.sqrt(float(np.sum(coefficients[0] ** 2)))
+    time_error = noise * math.sqrt(float(np.sum(coefficients[1] ** 2))) / abs(curvature)
+    tau_error = math.sqrt(2.0) * noise / (1.527 * peak_value / tau) / COS6_FWHM_PER_TAU
+    return PulseFit(
+        float(peak_value),
+        float(time[centre] + offset),
+        float(tau),
+        float(value_error),
+        float(time_error),
+        float(tau_error),
+        n_samples=length,
+    )
+
+
+def pulse_table(
+    traces: pd.DataFrame,
+    estimators=("fit_full",),
+    *,
+    rel_prominence: float = DEFAULT_REL_PROMINENCE,
+    min_snr: float = DEFAULT_MIN_SNR,
+    min_height_N: float = 0.0,
+) -> pd.DataFrame:
+    """The rows of ``pulses.csv``: every main pulse of every shot, per estimator.
+
+    Sensor S1 is the first sensor column of ``traces``, S2 the last. Roles (see
+    ``docs/interfaces.md``): in a collision shot the 1st pulse at S1 is the incident
+    LSTW and the 2nd the crossed RSTW; at S2 the 1st is the incident RSTW and the 2nd
+    the crossed LSTW; a reference shot has one pulse per sensor, role ``reference``,
+    wave LSTW. A pulse that is not detected gives rows with ``ok`` False and reason
+    "no pulse detected"; when a collision signal shows one pulse only, it is taken as
+    the incident one.
+
+    Parameters
+    ----------
+    traces : DataFrame
+        A trace table (:mod:`chain.traces`).
+    estimators : sequence of str
+        Names from :data:`ESTIMATORS`.
+    rel_prominence, min_snr, min_height_N
+        Detection thresholds, as in :func:`find_pulses`.
+
+    Returns
+    -------
+    DataFrame
+        ``source, model, N, shot, kind, amplitude, sensor, bead, role, wave, estimator,
+        F_m_N, T_s, tau_s, F_m_stderr_N, T_stderr_s, tau_stderr_s, ok, reason``, then
+        ``baseline_N, noise_N, n_samples``.
+    """
+    estimators = tuple(estimators)
+    unknown = [e for e in estimators if e not in ESTIMATORS]
+    if unknown:
+        raise ParameterError(f"unknown estimators {unknown}; choose from {ESTIMATORS}")
+    beads = sensor_beads(traces)
+    sensors = [("S1", beads[0])] + ([("S2", beads[-1])] if len(beads) > 1 else [])
+    rows = []
+    for shot, meta, time, forces in iter_shots(traces):
+        for sensor, bead in sensors:
+            roles = _roles(meta["kind"], sensor)
+            force = forces[bead]
+            baseline, noise = estimate_baseline(time, force)
+            segments = find_pulses(
+                time,
+                force,
+                max_pulses=len(roles),
+                baseline_N=baseline,
+                noise_N=noise,
+                rel_prominence=rel_prominence,
+                min_snr=min_snr,
+                min_height_N=min_height_N,
+            )
+            for i, (role, wave) in enumerate(roles):
+                for estimator in estimators:
+                    if i < len(segments):
+                        part = segments[i].slice
+                        fit = fit_pulse(
+                            time[part],
+                            force[part],
+                            estimator,
+                            baseline_N=baseline,
+                            noise_N=noise,
+                        )
+                    else:
+                        found = f" ({len(segments)} of {len(roles)} found)" if segments else ""
+                        fit = PulseFit.failed("no pulse detected" + found)
+                    rows.append(
+                        {
+                            "source": meta["source"],
+                            "model": meta["model"],
+                            "N": int(meta["N"]),
+                            "shot": shot,
+                            "kind": meta["kind"],
+                            "amplitude": int(meta["amplitude"]),
+                            "sensor": sensor,
+                            "bead": bead,
+                            "role": role,
+                            "wave": wave,
+                            "estimator": estimator,
+                            **_fit_columns(fit),
+                            "baseline_N": baseline,
+                            "noise_N": noise,
+                        }
+                    )
+    return pd.DataFrame(rows, columns=PULSE_COLUMNS)
+
+
+#: Columns of :func:`pulse_table`, in order.
+PULSE_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "shot",
+    "kind",
+    "amplitude",
+    "sensor",
+    "bead",
+    "role",
+    "wave",
+    "estimator",
+    "F_m_N",
+    "T_s",
+    "tau_s",
+    "F_m_stderr_N",
+    "T_stderr_s",
+    "tau_stderr_s",
+    "ok",
+    "reason",
+    "baseline_N",
+    "noise_N",
+    "n_samples",
+)
+
+
+def _roles(kind: str, sensor: str) -> list[tuple[str, str]]:
+    if kind == "reference":
+        return [("reference", "LSTW")]
+    if sensor == "S1":
+        return [("incident", "LSTW"), ("crossed", "RSTW")]
+    return [("incident", "RSTW"), ("crossed", "LSTW")]
+
+
+def _fit_columns(fit: PulseFit) -> dict:
+    values = asdict(fit)
+    return {
+        "F_m_N": values["peak_force"],
+        "T_s": values["arrival_time"],
+        "tau_s": values["tau"],
+        "F_m_stderr_N": values["peak_force_stderr"],
+        "T_stderr_s": values["arrival_time_stderr"],
+        "tau_stderr_s": values["tau_stderr"],
+        "ok": values["ok"],
+        "reason": values["reason"],
+        "n_samples": values["n_samples"],
+    }

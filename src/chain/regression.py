@@ -1,0 +1,245 @@
+"""Least-squares fits with standard errors: y = C x^p (p fixed), y = A x^p (p free),
+and y = slope x.
+
+Fixed exponent and proportional fits are linear in their one coefficient and solved in
+closed form: with g = x^p and weights w = 1/sigma^2 (w = 1 when no sigma is given),
+
+    C = sum(w g y) / sum(w g^2),   var(C) = s^2 / sum(w g^2),
+
+where s^2 = sum(w (y - C g)^2) / (n - 1) is the reduced chi-square (the residual
+variance when unweighted). Scaling by s^2 makes the standard error describe the scatter
+actually present, as ``scipy.optimize.curve_fit`` does by default
+(``absolute_sigma=False``); with ``absolute_sigma=True`` the given sigma are taken as
+the true errors and var(C) = 1 / sum(w g^2).
+
+The free power law is fitted in log-log (default): ln y = ln A + p ln x by
+:func:`scipy.stats.linregress` (weighted least squares by ``numpy.polyfit`` when sigma
+is given, with sigma_ln y = sigma / y), right for a relative scatter; or with
+``method="nonlinear"`` by ``scipy.optimize.curve_fit`` of A x^p on y itself, right for a
+constant absolute scatter. Both give the standard error of p from the residuals.
+
+A fit with too few points (fewer than 2 for one coefficient, 3 for two) returns NaN
+values and its ``n_points`` rather than raising, so that tables can hold the row.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import curve_fit
+from scipy.stats import linregress
+
+from chain.materials import ParameterError
+
+#: Fewest points for a one-coefficient fit (one degree of freedom left for its error).
+MIN_POINTS_ONE_PARAMETER = 2
+
+#: Fewest points for a two-parameter fit.
+MIN_POINTS_TWO_PARAMETERS = 3
+
+POWER_LAW_METHODS = ("loglog", "nonlinear")
+
+
+@dataclass(frozen=True)
+class CoefficientFit:
+    """y = coefficient x^exponent with the exponent fixed.
+
+    Attributes
+    ----------
+    coefficient : float
+        C (or the slope), in units of y / x^exponent.
+    stderr : float
+        Its standard error, same units.
+    exponent : float
+        The fixed exponent.
+    n_points : int
+        Points used.
+    rms_residual : float
+        Root-mean-square of y - C x^p, units of y.
+    """
+
+    coefficient: float
+    stderr: float
+    exponent: float
+    n_points: int
+    rms_residual: float
+
+
+@dataclass(frozen=True)
+class PowerLawFit:
+    """y = prefactor x^exponent with both free.
+
+    Attributes
+    ----------
+    prefactor, prefactor_stderr : float
+        A and its standard error, units of y / x^exponent.
+    exponent, exponent_stderr : float
+        p and its standard error.
+    n_points : int
+        Points used.
+    method : str
+        ``loglog`` or ``nonlinear``.
+    """
+
+    prefactor: float
+    prefactor_stderr: float
+    exponent: float
+    exponent_stderr: float
+    n_points: int
+    method: str
+
+
+def fit_fixed_exponent(
+    x, y, exponent: float = -1.0 / 6.0, sigma=None, *, absolute_sigma: bool = False
+) -> CoefficientFit:
+    """Least-squares C of y = C x^exponent with its standard error.
+
+    Parameters
+    ----------
+    x : array
+        Abscissae (e.g. F_m in N), > 0.
+    y : array
+        Ordinates (e.g. |Delta| in us).
+    exponent : float
+        The fixed exponent (default -1/6, Eq. 6).
+    sigma : array, optional
+        Standard errors of y, same units; None for unweighted least squares.
+    absolute_sigma : bool
+        Take ``sigma`` as absolute (True) or only relative (False, the error is then
+        scaled by the reduced chi-square).
+
+    Returns
+    -------
+    CoefficientFit
+        NaN coefficient and error with fewer than 2 points.
+    """
+    x, y, weight = _points(x, y, sigma)
+    n = x.size
+    if n < MIN_POINTS_ONE_PARAMETER:
+        return CoefficientFit(math.nan, math.nan, float(exponent), n, math.nan)
+    if np.any(x <= 0):
+        raise ParameterError("x must be > 0 for a power law")
+    basis = x**exponent
+    normal = float(np.sum(weight * basis**2))
+    coefficient = float(np.sum(weight * basis * y)) / normal
+    residual = y - coefficient * basis
+    if sigma is not None and absolute_sigma:
+        variance = 1.0 / normal
+    else:
+        variance = float(np.sum(weight * residual**2)) / (n - 1) / normal
+    return CoefficientFit(
+        coefficient,
+        math.sqrt(variance),
+        float(exponent),
+        n,
+        float(np.sqrt(np.mean(residual**2))),
+    )
+
+
+def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> CoefficientFit:
+    """Least-squares slope of y = slope x (through the origin) with its standard error.
+
+    Parameters
+    ----------
+    x, y : array
+        Abscissae and ordinates (e.g. F_m and the SSW amplitude, both in N).
+    sigma : array, optional
+        Standard errors of y; None for unweighted least squares.
+    absolute_sigma : bool
+        As in :func:`fit_fixed_exponent`.
+    """
+    x, y, weight = _points(x, y, sigma)
+    n = x.size
+    if n < MIN_POINTS_ONE_PARAMETER:
+        return CoefficientFit(math.nan, math.nan, 1.0, n, math.nan)
+    normal = float(np.sum(weight * x**2))
+    slope = float(np.sum(weight * x * y)) / normal
+    residual = y - slope * x
+    if sigma is not None and absolute_sigma:
+        variance = 1.0 / normal
+    else:
+        variance = float(np.sum(weight * residual**2)) / (n - 1) / normal
+    return CoefficientFit(slope, math.sqrt(variance), 1.0, n, float(np.sqrt(np.mean(residual**2))))
+
+
+def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
+    """Least-squares y = A x^p with A and p free, and their standard errors.
+
+    Parameters
+    ----------
+    x, y : array
+        Abscissae and ordinates, both > 0 (use |Delta| for delays).
+    sigma : array, optional
+        Standard errors of y; None for unweighted least squares.
+    method : {"loglog", "nonlinear"}
+        Straight line in ln y vs ln x, or nonlinear fit of y (module docstring).
+
+    Returns
+    -------
+    PowerLawFit
+        NaN values with fewer than 3 points.
+    """
+    if method not in POWER_LAW_METHODS:
+        raise ParameterError(f"method must be one of {POWER_LAW_METHODS}, got {method!r}")
+    x, y, weight = _points(x, y, sigma)
+    n = x.size
+    if n < MIN_POINTS_TWO_PARAMETERS:
+        return PowerLawFit(math.nan, math.nan, math.nan, math.nan, n, method)
+    if np.any(x <= 0) or np.any(y <= 0):
+        raise ParameterError("x and y must be > 0 for a power-law fit")
+    log_x, log_y = np.log(x), np.log(y)
+    if method == "loglog":
+        if sigma is None:
+            line = linregress(log_x, log_y)
+            exponent, exponent_error = line.slope, line.stderr
+            log_a, log_a_error = line.intercept, line.intercept_stderr
+        else:
+            # sigma of ln y is sigma / y; polyfit weights multiply the residuals.
+            log_weight = y * np.sqrt(weight)
+            coefficients, covariance = np.polyfit(log_x, log_y, 1, w=log_weight, cov="unscaled")
+            residual = log_weight * (log_y - np.polyval(coefficients, log_x))
+            covariance = covariance * float(np.sum(residual**2)) / (n - 2)
+            exponent, log_a = coefficients
+            exponent_error, log_a_error = np.sqrt(np.diag(covariance))
+        prefactor = math.exp(log_a)
+        return PowerLawFit(
+            prefactor,
+            prefactor * float(log_a_error),
+            float(exponent),
+            float(exponent_error),
+            n,
+            method,
+        )
+    start = fit_power_law(x, y, method="loglog")
+    params, covariance = curve_fit(
+        lambda u, a, p: a * u**p,
+        x,
+        y,
+        p0=(start.prefactor, start.exponent),
+        sigma=None if sigma is None else 1.0 / np.sqrt(weight),
+    )
+    errors = np.sqrt(np.diag(covariance))
+    return PowerLawFit(
+        float(params[0]), float(errors[0]), float(params[1]), float(errors[1]), n, method
+    )
+
+
+def _points(x, y, sigma):
+    x = np.asarray(x, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    if x.shape != y.shape:
+        raise ParameterError(f"x and y must have one length, got {x.size} and {y.size}")
+    if sigma is None:
+        weight = np.ones_like(y)
+    else:
+        sigma = np.asarray(sigma, dtype=float).ravel()
+        if sigma.shape != y.shape:
+            raise ParameterError(f"sigma must have {y.size} entries, got {sigma.size}")
+        if np.any(~np.isfinite(sigma)) or np.any(sigma <= 0):
+            raise ParameterError("sigma must be finite and > 0")
+        weight = sigma**-2
+    if np.any(~np.isfinite(x)) or np.any(~np.isfinite(y)):
+        raise ParameterError("x and y must be finite; drop flagged points before fitting")
+    return x, y, weight
