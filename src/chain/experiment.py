@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from chain.acquisition import (
     PCB_200B02_SENSITIVITY_MV_PER_N,
@@ -62,13 +63,15 @@ from chain.materials import (
 from chain.measured import (
     FORMAT_NAME,
     METADATA_FILE,
+    default_mode,
     impact_speed_from_drop_height,
+    read_metadata,
     write_metadata,
     write_shot_csv,
+    write_text_atomic,
 )
 from chain.model import PAPER_BEAD_RADIUS, PAPER_STRIKER_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
 from chain.simulation import default_time_step, simulate
-from chain.traces import write_csv_atomic
 
 #: Label written in every description field of a virtual dataset.
 VIRTUAL_LABEL = "virtual experiment (model)"
@@ -242,6 +245,36 @@ class VirtualExperiment:
                 f"virtual experiment: unknown settings {unknown}; known: {sorted(known)}"
             )
         return cls(**dict(mapping))
+
+    @classmethod
+    def from_dataset(cls, folder: str | os.PathLike) -> VirtualExperiment:
+        """The settings that wrote a virtual dataset, read back from its
+        ``metadata.yaml`` (to regenerate it, or to simulate it without noise).
+
+        Parameters
+        ----------
+        folder : path
+            A dataset folder written by :func:`run_virtual_experiment`.
+        """
+        path = Path(folder) / METADATA_FILE
+        read_metadata(folder)  # checks the format, names the file on error
+        mapping = yaml.safe_load(path.read_text(encoding="utf-8"))
+        apparatus = dict(mapping.get("apparatus") or {})
+        if apparatus.get("model") != VIRTUAL_LABEL:
+            raise ParameterError(f"{path}: not written by the virtual experiment")
+        for key in ("model", "generator"):
+            apparatus.pop(key, None)
+        if isinstance(apparatus.get("material"), Mapping):
+            apparatus["material"] = Material(**apparatus["material"])
+        return cls.from_dict(
+            {
+                **apparatus,
+                "n_beads": mapping["N"],
+                "sensor_beads": mapping["sensor_beads"],
+                "sensitivity_mV_per_N": mapping["sensitivity_mV_per_N"],
+                "sampling_interval_s": float(mapping["sampling_interval_s"]),
+            }
+        )
 
     @property
     def material_object(self) -> Material:
@@ -472,9 +505,11 @@ def run_virtual_experiment(
     out.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
+        os.chmod(staging, default_mode(directory=True))
         saturated = _write_shots(settings, plan, time, forces, rng, staging)
         truth = plan.assign(adc_saturated=saturated)
-        write_csv_atomic(truth, staging / TRUTH_FILE)
+        text = truth.to_csv(index=False, float_format="%.10g", lineterminator="\n")
+        write_text_atomic(text, staging / TRUTH_FILE)
         write_metadata(staging, _metadata(settings, plan, dataset_name))
         _replace_folder(staging, out)
     except BaseException:

@@ -477,6 +477,10 @@ def read_shot_csv(
     if data is None or not np.all(np.isfinite(data)):
         for number, row in enumerate(rows, start=2):
             for column, field in zip(expected, row):
+                if not field.strip():
+                    raise MeasuredDataError(
+                        f"{path} line {number}: column {column}: missing value (empty field)"
+                    )
                 try:
                     value = float(field)
                 except ValueError:
@@ -496,8 +500,8 @@ def read_shot_csv(
     if bad.size:
         number = int(bad[0]) + 3  # step i joins data rows i and i+1, i.e. lines i+2, i+3
         raise MeasuredDataError(
-            f"{path} line {number}: time {time[bad[0] + 1]!r} s does not increase "
-            f"(previous sample {time[bad[0]]!r} s)"
+            f"{path} line {number}: time {body[bad[0] + 1].split(',')[0].strip()} s does not "
+            f"increase (previous sample {body[bad[0]].split(',')[0].strip()} s)"
         )
     nominal = float(np.median(step)) if sampling_interval_s is None else sampling_interval_s
     bad = np.flatnonzero(np.abs(step - nominal) > TIME_STEP_TOLERANCE * nominal)
@@ -579,10 +583,29 @@ def load_dataset(folder: str | os.PathLike, name: str | None = None) -> pd.DataF
 # ----------------------------------------------------------------------------- writers
 
 
-def _write_text_atomic(text: str, path: Path) -> None:
+def default_mode(directory: bool = False) -> int:
+    """Permission bits a plain ``open``/``mkdir`` would give under the current umask
+    (``tempfile`` creates private 0600/0700 entries, wrong for shared data)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return (0o777 if directory else 0o666) & ~umask
+
+
+def write_text_atomic(text: str, path: str | os.PathLike) -> None:
+    """Write ``text`` to a temporary name beside ``path``, then rename it to ``path``.
+
+    Parameters
+    ----------
+    text : str
+        File content (UTF-8, written as is).
+    path : path
+        Destination; parent folders are created.
+    """
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
+        os.chmod(temporary, default_mode())
         with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
             stream.write(text)
         os.replace(temporary, path)
@@ -626,7 +649,7 @@ def write_shot_csv(path: str | os.PathLike, time_s, volts_V, sensor_beads: Seque
         header=header,
         comments="",
     )
-    _write_text_atomic(buffer.getvalue(), Path(path))
+    write_text_atomic(buffer.getvalue(), Path(path))
 
 
 def write_metadata(folder: str | os.PathLike, mapping: Mapping) -> Path:
@@ -645,5 +668,5 @@ def write_metadata(folder: str | os.PathLike, mapping: Mapping) -> Path:
     text = yaml.safe_dump(
         dict(mapping), sort_keys=False, default_flow_style=None, allow_unicode=True, width=100
     )
-    _write_text_atomic(text, path)
+    write_text_atomic(text, path)
     return path
