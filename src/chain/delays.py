@@ -108,16 +108,13 @@ def reference_tofs(pulses: pd.DataFrame) -> pd.DataFrame:
     """
     ref = pulses[(pulses["role"] == "reference") & pulses["ok"].astype(bool)]
     keys = [*_GROUP, "amplitude", "estimator", "shot"]
-    s1 = ref[ref["sensor"] == "S1"].set_index(keys)
-    s2 = ref[ref["sensor"] == "S2"].set_index(keys)
-    both = s1.join(s2, lsuffix="_1", rsuffix="_2", how="inner")
-    out = pd.DataFrame(
-        {
-            "tof_s": both["T_s_2"] - both["T_s_1"],
-            "tof_var_s2": both["T_stderr_s_1"] ** 2 + both["T_stderr_s_2"] ** 2,
-        }
+    columns = [*keys, "T_s", "T_stderr_s"]
+    both = ref.loc[ref["sensor"] == "S1", columns].merge(
+        ref.loc[ref["sensor"] == "S2", columns], on=keys, suffixes=("_1", "_2")
     )
-    return out.reset_index()
+    both["tof_s"] = both["T_s_2"] - both["T_s_1"]
+    both["tof_var_s2"] = both["T_stderr_s_1"] ** 2 + both["T_stderr_s_2"] ** 2
+    return both[[*keys, "tof_s", "tof_var_s2"]]
 
 
 def delay_table(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -235,7 +232,6 @@ def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
     DataFrame
         Columns :data:`DELAY_FIT_COLUMNS`.
     """
-    ok = delays[delays["ok"].astype(bool)]
     rows = []
     groups = [(keys, group) for keys, group in delays.groupby([*_GROUP, "estimator"], sort=True)]
     pooled = [
@@ -243,7 +239,7 @@ def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
         for (s, m, e), group in delays.groupby(["source", "model", "estimator"], sort=True)
     ]
     for (source, model, n_beads, estimator), group in groups + pooled:
-        used = ok.loc[ok.index.intersection(group.index)]
+        used = group[group["ok"].astype(bool)]
         force = used["F_m_N"].to_numpy(dtype=float)
         delay = np.abs(used["delay_us"].to_numpy(dtype=float))
         fixed = fit_fixed_exponent(force, delay, -1.0 / 6.0)
