@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.optimize import least_squares
-from scipy.signal import find_peaks, savgol_filter
+from scipy.signal import find_peaks, savgol_coeffs, savgol_filter
 
 from chain.delays import apply_selection
 from chain.pulses import estimate_baseline
@@ -45,8 +45,8 @@ WINDOW_TAUS = 6.0
 #: Least prominence of a distinct SSW peak, as a fraction of the crossed pulse.
 MIN_PEAK_FRACTION = 0.005
 
-#: Least prominence of a distinct SSW peak in noise standard deviations.
-MIN_PEAK_SNR = 5.0
+#: Least prominence of a distinct SSW peak in standard deviations of the smoothed noise.
+MIN_PEAK_SNR = 8.0
 
 SSW_METHODS = ("residual", "peak")
 
@@ -175,7 +175,11 @@ def measure_ssw(
     template = rescaled_template(time, ref_time, ref_signal, scale, shift, reference_arrival_s)
     window = (time >= time[top]) & (time <= time[top] + WINDOW_TAUS * tau)
     length = round(0.5 * tau / dt) | 1
-    smooth = (lambda y: savgol_filter(y, length, 2)) if 5 <= length < len(time) else (lambda y: y)
+    if 5 <= length < len(time):
+        smooth = lambda y: savgol_filter(y, length, 2)  # noqa: E731
+        noise_gain = math.sqrt(float(np.sum(savgol_coeffs(length, 2) ** 2)))
+    else:
+        smooth, noise_gain = (lambda y: y), 1.0
     residual = smooth(signal - template)
     indices = np.flatnonzero(window)
     best = int(indices[np.argmax(residual[indices])])
@@ -184,13 +188,16 @@ def measure_ssw(
         "scale": float(scale),
         "misfit": edge_misfit,
     }
-    # Distinct peaks: local maxima of the smoothed signal after the main pulse's peak.
-    smoothed = smooth(signal)[indices]
-    prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_N)
+    # Distinct peaks: local maxima of the smoothed signal from the main pulse's rise to
+    # the end of the window, the main pulse's own maximum (the largest) excluded.
+    region = np.arange(int(near[0]), int(indices[-1]) + 1)
+    smoothed = smooth(signal)[region]
+    prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
     peaks, _ = find_peaks(smoothed, prominence=prominence)
+    peaks = peaks[peaks > np.argmax(smoothed)]
     if peaks.size:
         first = int(peaks[0])
-        result["peak"] = (float(smoothed[first]), float(time[indices[first]]), "")
+        result["peak"] = (float(smoothed[first]), float(time[region[first]]), "")
     else:
         result["peak"] = (math.nan, math.nan, "no distinct SSW peak")
     return result
