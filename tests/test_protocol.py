@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from chain.materials import ParameterError
-from chain.protocol import SELECTION_COLUMNS, amplitude_mismatch, keep_selected, select_shots
+from chain.protocol import SELECTION_COLUMNS, amplitude_mismatch, select_shots
 
 
 def _pulse(shot, kind, sensor, role, force, ok=True, reason="", estimator="fit_full"):
@@ -136,10 +136,3 @@ def test_bad_tolerance(pulses, tolerance):
 def test_missing_pulse_columns():
     with pytest.raises(ParameterError, match=r"missing columns \['F_m_N'\]"):
         select_shots(pd.DataFrame(_collision(0, 1.0, 1.0)).drop(columns="F_m_N"))
-
-
-def test_keep_selected_drops_rejected_shots(pulses):
-    selection = select_shots(pulses)
-    kept = keep_selected(pulses, selection)
-    assert sorted(kept["shot"].unique()) == [0, 3]
-    assert keep_selected(pulses, None) is pulses

@@ -209,24 +209,3 @@ def _judge_reference(group: pd.DataFrame) -> dict:
         "kept": True,
         "reason": "kept: reference pulse fitted at " + " and ".join(sensors),
     }
-
-
-def keep_selected(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
-    """Rows of ``table`` whose shot was not rejected by ``selection``.
-
-    Parameters
-    ----------
-    table : DataFrame
-        Any table with source, model, N, shot (traces, pulses, delays...).
-    selection : DataFrame or None
-        Output of :func:`select_shots`; None keeps everything. Shots absent from the
-        selection are kept.
-    """
-    if selection is None:
-        return table
-    rejected = selection.loc[~selection["kept"].astype(bool), _KEY]
-    if rejected.empty:
-        return table
-    keys = pd.MultiIndex.from_frame(table[_KEY].astype({"N": "int64", "shot": "int64"}))
-    drop = pd.MultiIndex.from_frame(rejected.astype({"N": "int64", "shot": "int64"}))
-    return table[~keys.isin(drop)]
