@@ -1,0 +1,88 @@
+"""The analysis chain on real simulator output: conservative chains of 25 and 26 beads.
+
+With V0 on the end beads, free ends and no dissipation the Hertz chain is exactly
+self-similar (F ~ V0^(6/5), t ~ V0^(-1/5)), so every delay must scale as F_m^(-1/6)
+and every SSW as F_m: the fitted exponent tests the estimators' scale covariance on
+sampled data (1 us sampling, tau from ~70 to ~180 us), not the physics.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import chain
+from chain.delays import delay_fit_table, delay_table
+from chain.pulses import pulse_table
+from chain.ssw import ssw_fit_table, ssw_table
+from chain.theory import ballistic_delay_constant_exact
+
+#: Launch speeds: F_m from ~9 N to ~1 kN at the first sensor.
+SPEEDS_M_S = np.geomspace(0.02, 1.0, 7)
+#: Long enough for the weakest crossed wave (~300 m/s) to pass S2.
+DURATION_S = 2.6e-3
+SENSORS = {25: (9, 17), 26: (10, 17)}
+
+#: |p + 1/6| of the free power law (fit_full): the brief asks three decimals; the
+#: self-similarity makes it exact up to sampling (measured ~5e-6).
+EXPONENT_TOLERANCE = 5e-4
+#: C against the ballistic estimate with the exact Hertz contact time (37.7 us N^(1/6)):
+#: the ballistic picture is an approximation (measured C / C_bal_exact = 1.10 for
+#: N = 25 and 1.02 for N = 26).
+C_RATIO_RANGE = (0.9, 1.2)
+#: SSW / F_m is the same at every amplitude (self-similarity), to sampling accuracy.
+SSW_RATIO_SPREAD = 0.01
+
+
+@pytest.fixture(scope="module")
+def analysed():
+    pulses, delays, ssw = [], [], []
+    for n_beads, sensors in SENSORS.items():
+        traces, _ = chain.simulate_shots(
+            chain.uniform_chain(n_beads),
+            SPEEDS_M_S,
+            sensors,
+            model_name="elastic",
+            duration=DURATION_S,
+        )
+        table = pulse_table(traces, estimators=("fit_full", "peak", "fit_rise"))
+        pulses.append(table)
+        delays.append(delay_table(table))
+        ssw.append(ssw_table(traces, table))
+    return (
+        pd.concat(pulses, ignore_index=True),
+        pd.concat(delays, ignore_index=True),
+        pd.concat(ssw, ignore_index=True),
+    )
+
+
+def test_every_pulse_and_delay_is_measured(analysed):
+    pulses, delays, _ = analysed
+    assert pulses["ok"].all(), pulses.loc[~pulses["ok"], "reason"].unique()
+    assert delays["ok"].all()
+    # Crossed waves arrive early at every amplitude, with every estimator.
+    assert (delays["delay_us"] < 0).all()
+    incident = delays[delays["estimator"] == "fit_full"]["F_m_N"]
+    assert incident.min() < 12.0 and incident.max() > 900.0
+
+
+@pytest.mark.parametrize("n_beads", sorted(SENSORS))
+def test_delay_exponent_is_minus_one_sixth(analysed, n_beads):
+    fits = delay_fit_table(analysed[1])
+    row = fits[(fits["N"] == n_beads) & (fits["estimator"] == "fit_full")].iloc[0]
+    assert abs(row["exponent"] + 1.0 / 6.0) < EXPONENT_TOLERANCE, row["exponent"]
+    ratio = row["C_us_N16"] / (ballistic_delay_constant_exact(chain.STEEL_100C6, 13e-3) * 1e6)
+    assert C_RATIO_RANGE[0] < ratio < C_RATIO_RANGE[1], row["C_us_N16"]
+
+
+def test_ssw_stronger_when_waves_cross_at_a_contact(analysed):
+    ssw = analysed[2]
+    residual = ssw[ssw["method"] == "residual"]
+    assert residual["ok"].all()
+    for _, group in residual.groupby("N"):
+        ratio = group["ssw_N"] / group["F_m_N"]
+        assert ratio.std() / ratio.mean() < SSW_RATIO_SPREAD
+    slopes = ssw_fit_table(ssw).set_index("N")["slope"]
+    # Even chain: the waves meet at the middle contact, and the SSW is larger (Sec. V).
+    assert slopes[26] > slopes[25] > 0
