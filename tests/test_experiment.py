@@ -223,6 +223,13 @@ def test_rerun_replaces_a_dataset_but_not_other_folders(tmp_path):
     assert (precious / "notes.txt").read_text() == "keep me"
 
 
+def test_adc_saturation_is_flagged(tmp_path):
+    loud = dataclasses.replace(TINY, impact_speeds_m_s=(6.0,), reference_shots=0, duration_s=3e-4)
+    with pytest.warns(UserWarning, match=r"ADC saturated .* in shots \[0\]; raise adc_range_V"):
+        out = run_virtual_experiment(loud, tmp_path / "loud", "virtual")
+    assert pd.read_csv(out / TRUTH_FILE)["adc_saturated"].tolist() == [True]
+
+
 def test_example_dataset_is_what_its_settings_make(tmp_path):
     """tests/data/virtual_small was written by the virtual experiment with the settings
     stored in its own metadata; regenerating it gives the same shots (to one ADC code,

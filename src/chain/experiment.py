@@ -38,6 +38,7 @@ import math
 import os
 import shutil
 import tempfile
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -507,6 +508,13 @@ def run_virtual_experiment(
     try:
         os.chmod(staging, default_mode(directory=True))
         saturated = _write_shots(settings, plan, time, forces, rng, staging)
+        if saturated.any():
+            # A lab would re-range the digitiser; a clipped top biases the amplitude fit.
+            warnings.warn(
+                f"virtual experiment: the ADC saturated (|V| >= {settings.adc_range_V} V) in "
+                f"shots {plan['shot'][saturated].tolist()}; raise adc_range_V",
+                stacklevel=2,
+            )
         truth = plan.assign(adc_saturated=saturated)
         text = truth.to_csv(index=False, float_format="%.10g", lineterminator="\n")
         write_text_atomic(text, staging / TRUTH_FILE)
