@@ -314,9 +314,14 @@ def plan_shots(settings: VirtualExperiment) -> pd.DataFrame:
     """The shots of a virtual experiment and their random imperfections (no simulation).
 
     Shots are numbered amplitude by amplitude, collisions first, then references, as a
-    lab would take them. The random draws come from ``default_rng(seed)`` in a fixed
-    order; :func:`run_virtual_experiment` then draws the noise from the same generator,
-    so call this only through it when the bytes matter (it is public for inspection).
+    lab would take them. This is the plan :func:`run_virtual_experiment` uses: its
+    draws come first from ``default_rng(seed)``, in a fixed order, and the sensor noise
+    is drawn after them from the same generator.
+
+    Parameters
+    ----------
+    settings : VirtualExperiment
+        The apparatus and the shot plan.
 
     Returns
     -------
