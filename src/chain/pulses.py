@@ -202,8 +202,9 @@ def find_pulses(
     Peaks are found with :func:`scipy.signal.find_peaks`; a main pulse has a prominence
     of at least ``rel_prominence`` times the largest excursion and a height above
     ``max(min_snr * noise_N, min_height_N)``. The ``max_pulses`` most prominent are
-    kept. Neighbours are split at the minimum of the signal between their peaks; a
-    free side extends :data:`SEGMENT_HALF_WIDTH_FWHM` widths at half maximum.
+    kept; maxima closer than the full width at half maximum of the largest pulse count
+    as one (ties of a quantised top). Neighbours are split at the minimum of the signal
+    between their peaks; a free side extends :data:`SEGMENT_HALF_WIDTH_FWHM` widths at half maximum.
 
     Parameters
     ----------
@@ -238,7 +239,16 @@ def find_pulses(
     threshold = max(min_snr * noise_N, min_height_N)
     if not largest > threshold or largest <= 0:
         return []
-    peaks, properties = find_peaks(signal, height=threshold, prominence=rel_prominence * largest)
+    # Samples of one top tie when the data are quantised (each then has the full
+    # prominence): maxima closer than the width at half maximum of the largest pulse
+    # belong to one pulse, and pulses that close could not be told apart anyway.
+    fwhm = _half_width_samples(signal, int(np.argmax(signal)))
+    peaks, properties = find_peaks(
+        signal,
+        height=threshold,
+        prominence=rel_prominence * largest,
+        distance=max(1.0, fwhm),
+    )
     if peaks.size == 0:
         return []
     strongest = np.argsort(properties["prominences"])[::-1][:max_pulses]
