@@ -134,6 +134,18 @@ def test_overlapping_pulses_are_split_at_the_minimum():
         assert fit.arrival_time == pytest.approx(arrival, abs=0.5e-6)
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_quantised_tops_are_one_pulse_each(seed):
+    # A 12-bit digitiser at 11.24 mV/N over +-2 V: steps of 0.087 N on a 10 N pulse, so
+    # several top samples tie and each has the full prominence.
+    step = 4.0 / 2**12 / 11.24e-3
+    rng = np.random.default_rng(seed)
+    clean = cos6_pulse(TIME_S, 10.0, 250e-6, TAU_S) + cos6_pulse(TIME_S, 9.5, 700e-6, TAU_S)
+    force = np.round((clean + rng.normal(0.0, 0.1, TIME_S.size)) / step) * step
+    segments = find_pulses(TIME_S, force, max_pulses=2)
+    assert [TIME_S[s.peak] for s in segments] == pytest.approx([250e-6, 700e-6], abs=15e-6)
+
+
 def test_noise_only_signal_has_no_pulse():
     rng = np.random.default_rng(3)
     force = OFFSET_N + rng.normal(0.0, 5.0, TIME_S.size)
