@@ -7,7 +7,9 @@ with one of the :data:`ESTIMATORS`:
 
 ``fit_full`` (the paper's method)
     least squares of F_m cos^6((t - T)/tau) on -tau < t - T < tau, the window
-    re-selected from the new (T, tau) until the set of samples no longer changes;
+    re-selected from the new (T, tau) until the set of samples no longer changes (or,
+    with noise, cycles between windows whose fits agree within 2 standard errors);
+    initial tau from the full width at half maximum, FWHM = 2 tau arccos(2^(-1/6));
 ``peak``
     parabolic interpolation of the maximum: the vertex of the least-squares parabola
     through the samples within tau/4 of the largest one (the 3-point parabola when the
