@@ -11,8 +11,8 @@ shoulder on the trailing edge. Two measurements, one row each in ``ssw.csv``:
     distance from its launching end) is turned into a solitary wave of the crossed
     pulse's size by the Hertz self-similarity -- force scale a, time scale a^(-1/6) --
     and aligned on the crossed pulse by least squares on its rising edge and top
-    (-tau < t - T <= t_peak, which the trailing SSW does not reach), a and the time
-    shift free. The SSW amplitude is the largest value of crossed signal minus this
+    (from T - tau to its highest sample, which the trailing SSW does not reach), a and
+    the time shift free. The SSW amplitude is the largest value of crossed signal minus this
     template from the crossed pulse's peak to :data:`WINDOW_TAUS` tau after it,
     after a quadratic Savitzky-Golay smoothing tau/2 long (the SSW is about tau wide,
     the noise is not). With no SSW it is ~0 (a few noise sigma / sqrt(tau/2 samples)).
@@ -100,7 +100,12 @@ def rescaled_template(time_s, reference_time_s, reference_force_N, scale, arriva
         Arrival time T_ref of the reference pulse, s.
     """
     spline = CubicSpline(reference_time_s, reference_force_N, extrapolate=False)
-    source = ref_arrival_s + (np.asarray(time_s) - arrival_s) * scale ** (1.0 / 6.0)
+    return _template(spline, np.asarray(time_s, dtype=float), scale, arrival_s, ref_arrival_s)
+
+
+def _template(spline, time, scale, arrival, ref_arrival):
+    # Zero outside the reference record (the spline does not extrapolate).
+    source = ref_arrival + (time - arrival) * scale ** (1.0 / 6.0)
     return np.nan_to_num(scale * spline(source), nan=0.0)
 
 
@@ -161,8 +166,7 @@ def measure_ssw(
 
     def misfit(params):
         scale, shift = params
-        source = reference_arrival_s + (time[edge] - shift) * scale ** (1.0 / 6.0)
-        return np.nan_to_num(scale * spline(source), nan=0.0) - signal[edge]
+        return _template(spline, time[edge], scale, shift, reference_arrival_s) - signal[edge]
 
     start = (crossed_peak_N / reference_peak_N, arrival)
     solution = least_squares(
@@ -172,14 +176,15 @@ def measure_ssw(
     # How well a solitary wave matches the crossed pulse where no SSW can be: a floor
     # below which an SSW amplitude means nothing.
     edge_misfit = float(np.max(np.abs(solution.fun)))
-    template = rescaled_template(time, ref_time, ref_signal, scale, shift, reference_arrival_s)
+    template = _template(spline, time, scale, shift, reference_arrival_s)
     window = (time >= time[top]) & (time <= time[top] + WINDOW_TAUS * tau)
     length = round(0.5 * tau / dt) | 1
-    if 5 <= length < len(time):
-        smooth = lambda y: savgol_filter(y, length, 2)  # noqa: E731
-        noise_gain = math.sqrt(float(np.sum(savgol_coeffs(length, 2) ** 2)))
-    else:
-        smooth, noise_gain = (lambda y: y), 1.0
+    smoothing = 5 <= length < len(time)
+
+    def smooth(values):
+        return savgol_filter(values, length, 2) if smoothing else values
+
+    noise_gain = math.sqrt(float(np.sum(savgol_coeffs(length, 2) ** 2))) if smoothing else 1.0
     residual = smooth(signal - template)
     indices = np.flatnonzero(window)
     best = int(indices[np.argmax(residual[indices])])
