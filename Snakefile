@@ -1,0 +1,32 @@
+# hertzchain: Santibanez et al., "Experimental evidence of solitary wave interaction
+# in Hertzian chains", reproduced. `snakemake --cores 2` rebuilds results/<run_name>/;
+# what-if runs: `snakemake --cores 2 --configfile whatif/<name>.yaml`;
+# report: `snakemake --report results/<run_name>/report.html` (or the `report` rule).
+
+from snakemake.utils import min_version, validate
+
+min_version("9.0")
+
+
+configfile: "config.yaml"
+
+
+validate(config, "workflow/schemas/config.schema.yaml")
+
+
+report: "workflow/report/workflow.rst"
+
+
+include: "workflow/rules/common.smk"
+
+
+rule all:
+    default_target: True
+    input:
+        final_targets,
+
+
+include: "workflow/rules/simulate.smk"
+include: "workflow/rules/analyse.smk"
+include: "workflow/rules/figures.smk"
+include: "workflow/rules/report.smk"

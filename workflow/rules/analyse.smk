@@ -1,0 +1,101 @@
+# Analysis: pulses (cos^6 fits) of every trace file, then the crossing delays, the
+# secondary solitary waves (SSW) and their fits, as the contract tables. The analysis
+# takes well under a second per trace file, so each table is one job (a job costs
+# ~2 s of Python start-up).
+
+
+rule pulses:
+    input:
+        traces=all_trace_files,
+        lib=LIB_PULSES,
+    output:
+        report(
+            f"{TABLES}/pulses.csv", caption="../report/pulses.rst", category="Tables"
+        ),
+    log:
+        f"{LOGS}/tables/pulses.log",
+    benchmark:
+        f"{BENCH}/tables/pulses.tsv"
+    conda:
+        ENV
+    params:
+        estimators=config["analysis"]["estimators"],
+    script:
+        "../scripts/pulses.py"
+
+
+rule delays:
+    input:
+        pulses=f"{TABLES}/pulses.csv",
+        selection=SELECTION,
+        lib=LIB_DELAYS,
+    output:
+        f"{TABLES}/delays.csv",
+    log:
+        f"{LOGS}/tables/delays.log",
+    benchmark:
+        f"{BENCH}/tables/delays.tsv"
+    conda:
+        ENV
+    script:
+        "../scripts/delays.py"
+
+
+rule delay_fits:
+    input:
+        delays=f"{TABLES}/delays.csv",
+        lib=LIB_DELAYS,
+    output:
+        report(
+            f"{TABLES}/delay_fits.csv",
+            caption="../report/delay_fits.rst",
+            category="Tables",
+        ),
+    log:
+        f"{LOGS}/tables/delay_fits.log",
+    benchmark:
+        f"{BENCH}/tables/delay_fits.tsv"
+    conda:
+        ENV
+    script:
+        "../scripts/delay_fits.py"
+
+
+rule ssw:
+    input:
+        traces=all_trace_files,
+        pulses=f"{TABLES}/pulses.csv",
+        selection=SELECTION,
+        lib=LIB_SSW,
+    output:
+        f"{TABLES}/ssw.csv",
+    log:
+        f"{LOGS}/tables/ssw.log",
+    benchmark:
+        f"{BENCH}/tables/ssw.tsv"
+    conda:
+        ENV
+    params:
+        estimator=config["analysis"]["main_estimator"],
+    script:
+        "../scripts/ssw.py"
+
+
+rule ssw_fits:
+    input:
+        ssw=f"{TABLES}/ssw.csv",
+        lib=LIB_SSW,
+    output:
+        report(
+            f"{TABLES}/ssw_fits.csv",
+            caption="../report/ssw_fits.rst",
+            category="Tables",
+        ),
+    log:
+        f"{LOGS}/tables/ssw_fits.log",
+    benchmark:
+        f"{BENCH}/tables/ssw_fits.tsv"
+    conda:
+        ENV
+    script:
+        "../scripts/ssw_fits.py"

@@ -1,0 +1,126 @@
+# Shared definitions: config checks, output paths, the library files each stage
+# depends on, and the lists of targets. Other rule files only use names from here.
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from chain.config_checks import check_config
+
+check_config(config)
+
+
+wildcard_constraints:
+    source="simulation|experiment",
+    model="[A-Za-z][A-Za-z0-9-]*",
+    N=r"\d+",
+
+
+RUN = config["run_name"]
+OUT = f"results/{RUN}"
+FIGURES = f"{OUT}/figures"
+TABLES = f"{OUT}/tables"
+LOGS = f"{OUT}/logs"
+ENV = "../envs/hertzchain.yaml"
+BENCH = f"{OUT}/benchmarks"
+
+MODELS = {m["name"]: m for m in config["models"]}
+CHAINS = {c["N"]: c for c in config["chains"]}
+# Launch speeds V0, m/s, geometric; rounded so that params are stable text.
+SPEEDS = [
+    float(f"{v:.12g}")
+    for v in np.geomspace(
+        config["launch"]["v0_min_m_s"],
+        config["launch"]["v0_max_m_s"],
+        config["launch"]["count"],
+    )
+]
+# Models without dissipation: their energy drift is the integrator's error.
+CONSERVATIVE = [name for name, m in MODELS.items() if m["eta_s"] == 0]
+TRACES_N = config["figures"]["traces_N"] or list(CHAINS)
+
+# The library that the jobs import: its source files are inputs of the rules that
+# use them, so editing the physics reruns the simulations, editing the analysis
+# reruns the tables, and editing figures.py only redraws.
+# (Not `import chain`: the name would shadow a Snakemake global.)
+LIB = Path(importlib.util.find_spec("chain").origin).parent
+
+
+def lib(*modules):
+    return [str(LIB / f"{module}.py") for module in modules]
+
+
+LIB_SIMULATE = lib("materials", "model", "integrator", "simulation", "theory", "traces")
+LIB_PULSES = lib("traces", "theory", "pulses")
+LIB_DELAYS = LIB_PULSES + lib("regression", "delays")
+LIB_SSW = LIB_PULSES + lib("regression", "ssw")
+LIB_FIGURES = lib("figures", "theory", "materials", "summary")
+LIB_SUMMARY = lib("summary", "theory", "materials")
+
+
+# ---- trace sources -------------------------------------------------------------
+# A "part" is one trace file: (source, model, N). The simulation gives one per
+# model and chain; the analysis reads them all. Experiment traces (virtual or measured, issue 5) plug in by
+# appending to EXPERIMENT_PARTS in workflow/rules/experiment.smk and providing
+# results/<run>/experiment/<model>_N<N>_traces.csv (+ SELECTION, if any).
+SIMULATION_PARTS = [("simulation", model, n) for model in MODELS for n in CHAINS]
+EXPERIMENT_PARTS = []
+# Files of chain.protocol.select_shots, passed to the delay and SSW tables.
+SELECTION = []
+# Label of experiment series in figures ("virtual experiment (model)" for a model).
+EXPERIMENT_LABEL = "experiment"
+
+
+def trace_file(source, model, n):
+    return f"{OUT}/{source}/{model}_N{n}_traces.csv"
+
+
+def all_parts():
+    return SIMULATION_PARTS + EXPERIMENT_PARTS
+
+
+def all_trace_files(wildcards=None):
+    return [trace_file(*part) for part in all_parts()]
+
+
+def runs_files():
+    return [
+        f"{OUT}/simulation/{model}_N{n}_runs.csv" for _, model, n in SIMULATION_PARTS
+    ]
+
+
+def figure(name):
+    """The PDF and PNG of a figure (contract name without extension)."""
+    return [f"{FIGURES}/{name}.pdf", f"{FIGURES}/{name}.png"]
+
+
+def figure_outputs(name):
+    pdf, png = figure(name)
+    return {
+        "pdf": pdf,
+        "png": report(png, caption=f"../report/{name}.rst", category="Figures"),
+    }
+
+
+def figure_names():
+    names = [
+        "fig1_setup",
+        "fig3_simulation_traces",
+        "fig4_delay_vs_force",
+        "fig5_ssw_vs_force",
+    ]
+    if EXPERIMENT_PARTS:
+        names.insert(1, "fig2_experiment_traces")
+    if config["figures"]["parity_ssw_vs_N"]:
+        names.append("fig_parity_ssw_vs_N")
+    return names
+
+
+def final_targets(wildcards=None):
+    tables = ["pulses", "delays", "delay_fits", "ssw", "ssw_fits"]
+    return (
+        [f"{TABLES}/{table}.csv" for table in tables]
+        + [path for name in figure_names() for path in figure(name)]
+        + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
+    )

@@ -1,0 +1,122 @@
+# Figures: one rule per figure. They read tables and traces only, so restyling a
+# figure (src/chain/figures.py) redraws it and never reruns a simulation.
+
+
+rule fig1_setup:
+    input:
+        LIB_FIGURES,
+    output:
+        **figure_outputs("fig1_setup"),
+    log:
+        f"{LOGS}/figures/fig1_setup.log",
+    conda:
+        ENV
+    params:
+        chains=config["chains"],
+        radius_m=config["radius_m"],
+        material=config["material"],
+        striker_radius_m=config["setup"]["striker_radius_m"],
+    script:
+        "../scripts/fig1_setup.py"
+
+
+rule fig2_experiment_traces:
+    input:
+        traces=lambda wildcards: [
+            trace_file(*part) for part in EXPERIMENT_PARTS if part[2] in TRACES_N
+        ],
+        pulses=f"{TABLES}/pulses.csv",
+        ssw=f"{TABLES}/ssw.csv",
+        lib=LIB_FIGURES,
+    output:
+        **figure_outputs("fig2_experiment_traces"),
+    log:
+        f"{LOGS}/figures/fig2_experiment_traces.log",
+    conda:
+        ENV
+    params:
+        model=None,
+        representative_force_N=config["figures"]["representative_force_N"],
+        representative_index=config["figures"]["representative_index"],
+        estimator=config["analysis"]["main_estimator"],
+        label=EXPERIMENT_LABEL,
+    script:
+        "../scripts/fig_traces.py"
+
+
+rule fig3_simulation_traces:
+    input:
+        traces=[
+            trace_file("simulation", config["figures"]["traces_model"], n)
+            for n in TRACES_N
+        ],
+        pulses=f"{TABLES}/pulses.csv",
+        ssw=f"{TABLES}/ssw.csv",
+        lib=LIB_FIGURES,
+    output:
+        **figure_outputs("fig3_simulation_traces"),
+    log:
+        f"{LOGS}/figures/fig3_simulation_traces.log",
+    conda:
+        ENV
+    params:
+        model=config["figures"]["traces_model"],
+        representative_force_N=config["figures"]["representative_force_N"],
+        representative_index=config["figures"]["representative_index"],
+        estimator=config["analysis"]["main_estimator"],
+        label="simulation",
+    script:
+        "../scripts/fig_traces.py"
+
+
+rule fig4_delay_vs_force:
+    input:
+        delays=f"{TABLES}/delays.csv",
+        fits=f"{TABLES}/delay_fits.csv",
+        lib=LIB_FIGURES,
+    output:
+        **figure_outputs("fig4_delay_vs_force"),
+    log:
+        f"{LOGS}/figures/fig4_delay_vs_force.log",
+    conda:
+        ENV
+    params:
+        material=config["material"],
+        radius_m=config["radius_m"],
+        estimator=config["analysis"]["main_estimator"],
+        experiment_label=EXPERIMENT_LABEL,
+    script:
+        "../scripts/fig4_delay_vs_force.py"
+
+
+rule fig5_ssw_vs_force:
+    input:
+        ssw=f"{TABLES}/ssw.csv",
+        fits=f"{TABLES}/ssw_fits.csv",
+        lib=LIB_FIGURES,
+    output:
+        **figure_outputs("fig5_ssw_vs_force"),
+    log:
+        f"{LOGS}/figures/fig5_ssw_vs_force.log",
+    conda:
+        ENV
+    params:
+        experiment_label=EXPERIMENT_LABEL,
+    script:
+        "../scripts/fig5_ssw_vs_force.py"
+
+
+rule fig_parity_ssw_vs_N:
+    input:
+        fits=f"{TABLES}/ssw_fits.csv",
+        lib=LIB_FIGURES,
+    output:
+        **figure_outputs("fig_parity_ssw_vs_N"),
+    log:
+        f"{LOGS}/figures/fig_parity_ssw_vs_N.log",
+    conda:
+        ENV
+    params:
+        experiment_label=EXPERIMENT_LABEL,
+    script:
+        "../scripts/fig_parity_ssw_vs_N.py"

@@ -1,0 +1,47 @@
+# The summary beside the paper's numbers, and the HTML report.
+
+
+rule summary:
+    input:
+        delay_fits=f"{TABLES}/delay_fits.csv",
+        ssw_fits=f"{TABLES}/ssw_fits.csv",
+        runs=runs_files(),
+        lib=LIB_SUMMARY,
+    output:
+        json=f"{OUT}/summary.json",
+        md=report(
+            f"{OUT}/summary.md", caption="../report/summary.rst", category="Summary"
+        ),
+    log:
+        f"{LOGS}/summary.log",
+    conda:
+        ENV
+    params:
+        run_name=RUN,
+        material=config["material"],
+        radius_m=config["radius_m"],
+        conservative_models=CONSERVATIVE,
+        estimator=config["analysis"]["main_estimator"],
+    script:
+        "../scripts/summary.py"
+
+
+# `snakemake --cores 2 report` builds everything, then the self-contained HTML report
+# (the same as `snakemake --report results/<run_name>/report.html` after a run).
+rule report:
+    input:
+        final_targets,
+    output:
+        f"{OUT}/report.html",
+    log:
+        f"{LOGS}/report.log",
+    conda:
+        ENV
+    params:
+        snakefile=workflow.main_snakefile,
+        configfiles=" ".join(
+            f"--configfile {path}" for path in workflow.overwrite_configfiles
+        ),
+    shell:
+        "snakemake --snakefile {params.snakefile} {params.configfiles} "
+        "--report {output} --nolock > {log} 2>&1"

@@ -1,0 +1,11 @@
+"""Reading helpers shared by the scripts (no analysis here)."""
+
+import pandas as pd
+
+
+def selection(snakemake):
+    """The shot-selection table (chain.protocol.select_shots), or None to keep all shots."""
+    paths = list(snakemake.input.get("selection", []))
+    if not paths:
+        return None
+    return pd.concat([pd.read_csv(path) for path in paths], ignore_index=True)

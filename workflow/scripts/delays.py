@@ -1,0 +1,13 @@
+"""Crossing delay of every collision shot (chain.delays.delay_table)."""
+
+import pandas as pd
+from _inputs import selection
+from _logging import start
+
+from chain.delays import delay_table
+from chain.traces import write_csv_atomic
+
+log = start(snakemake)
+table = delay_table(pd.read_csv(snakemake.input.pulses), selection=selection(snakemake))
+log.info("%d delay rows", len(table))
+write_csv_atomic(table, snakemake.output[0])

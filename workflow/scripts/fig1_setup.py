@@ -1,0 +1,18 @@
+"""Fig. 1, the setup, drawn from the configured chains (chain.figures.fig1_setup)."""
+
+from pathlib import Path
+
+from _logging import start
+
+from chain.figures import fig1_setup, save_figure
+
+log = start(snakemake)
+p = snakemake.params
+fig = fig1_setup(
+    p.chains,
+    bead_radius_m=p.radius_m,
+    striker_radius_m=p.striker_radius_m,
+    material=p.material,
+)
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+log.info("done")

@@ -1,0 +1,21 @@
+"""Fig. 4: |Delta| against F_m (chain.figures.fig4_delay_vs_force)."""
+
+from pathlib import Path
+
+import pandas as pd
+from _logging import start
+
+from chain.figures import fig4_delay_vs_force, save_figure
+from chain.summary import run_constants
+
+log = start(snakemake)
+p = snakemake.params
+fig = fig4_delay_vs_force(
+    pd.read_csv(snakemake.input.delays),
+    pd.read_csv(snakemake.input.fits),
+    constants=run_constants(p.material, p.radius_m),
+    estimator=p.estimator,
+    experiment_label=p.experiment_label,
+)
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+log.info("done")

@@ -1,0 +1,15 @@
+"""What-if figure: SSW slope against N, odd and even (chain.figures.fig_parity_ssw_vs_N)."""
+
+from pathlib import Path
+
+import pandas as pd
+from _logging import start
+
+from chain.figures import fig_parity_ssw_vs_N, save_figure
+
+log = start(snakemake)
+fig = fig_parity_ssw_vs_N(
+    pd.read_csv(snakemake.input.fits), experiment_label=snakemake.params.experiment_label
+)
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+log.info("done")

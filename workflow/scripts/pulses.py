@@ -1,0 +1,16 @@
+"""Fit the pulses of every trace file (chain.pulses.pulse_table)."""
+
+import pandas as pd
+from _logging import start
+
+from chain.pulses import pulse_table
+from chain.traces import read_traces, write_csv_atomic
+
+log = start(snakemake)
+estimators = tuple(snakemake.params.estimators)
+tables = []
+for path in snakemake.input.traces:
+    table = pulse_table(read_traces(path), estimators=estimators)
+    log.info("%s: %d pulse rows, %d not ok", path, len(table), int((~table["ok"]).sum()))
+    tables.append(table)
+write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output[0])

@@ -1,0 +1,20 @@
+"""Secondary solitary waves behind every crossed pulse (chain.ssw.ssw_table)."""
+
+import pandas as pd
+from _inputs import selection
+from _logging import start
+
+from chain.ssw import ssw_table
+from chain.traces import read_traces, write_csv_atomic
+
+log = start(snakemake)
+pulses = pd.read_csv(snakemake.input.pulses)
+shots = selection(snakemake)
+tables = []
+for path in snakemake.input.traces:
+    table = ssw_table(
+        read_traces(path), pulses, selection=shots, estimator=snakemake.params.estimator
+    )
+    log.info("%s: %d SSW rows", path, len(table))
+    tables.append(table)
+write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output[0])

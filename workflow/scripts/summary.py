@@ -1,0 +1,21 @@
+"""summary.json and summary.md: the run's numbers beside the paper's (chain.summary)."""
+
+import pandas as pd
+from _logging import start
+
+from chain.summary import build_summary, write_summary
+
+log = start(snakemake)
+p = snakemake.params
+summary = build_summary(
+    run_name=p.run_name,
+    material=p.material,
+    radius_m=p.radius_m,
+    delay_fits=pd.read_csv(snakemake.input.delay_fits),
+    ssw_fits=pd.read_csv(snakemake.input.ssw_fits),
+    runs=pd.concat([pd.read_csv(path) for path in snakemake.input.runs], ignore_index=True),
+    conservative_models=p.conservative_models,
+    main_estimator=p.estimator,
+)
+write_summary(summary, snakemake.output.json, snakemake.output.md)
+log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
