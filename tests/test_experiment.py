@@ -23,7 +23,7 @@ from chain.experiment import (
 from chain.materials import ParameterError
 from chain.measured import METADATA_FILE, load_dataset
 from chain.protocol import select_shots
-from chain.pulses import find_pulses, pulse_table
+from chain.pulses import pulse_table
 
 EXAMPLE = Path(__file__).parent / "data" / "virtual_small"
 
@@ -59,35 +59,6 @@ NOISE_FREE = dataclasses.replace(
     timing_jitter_s=0.0,
     noise_N=0.0,
     adc_bits=None,
-)
-
-
-def _splits_tied_peaks() -> bool:
-    """True while chain.pulses.find_pulses counts two noise maxima of equal (quantised)
-    value on the top of one pulse as two pulses (scipy gives tied peaks full prominence).
-    Quantised signals, as every digitiser records, then fail in collision shots."""
-    time = np.arange(0.0, 1.2e-3, 1e-6)
-    tau = 1.4e-4
-
-    def pulse(arrival, force):
-        phase = (time - arrival) / tau
-        return np.where(np.abs(phase) < np.pi / 2, force * np.cos(phase) ** 6, 0.0)
-
-    step = 0.087  # 12-bit ADC over +-2 V at 11.24 mV/N
-    for seed in range(10):
-        signal = pulse(4e-4, 12.6) + pulse(9e-4, 12.2)
-        signal += np.random.default_rng(seed).normal(0.0, 0.1, time.size)
-        signal = np.round(signal / step) * step
-        peaks = [segment.peak for segment in find_pulses(time, signal, 2)]
-        if len(peaks) == 2 and peaks[1] - peaks[0] < 100:
-            return True
-    return False
-
-
-needs_tie_robust_pulses = pytest.mark.xfail(
-    _splits_tied_peaks(),
-    reason="chain.pulses.find_pulses splits a quantised pulse top into two pulses",
-    strict=True,
 )
 
 
@@ -266,7 +237,6 @@ def noise_free(tmp_path_factory):
     return _analyse(run_virtual_experiment(NOISE_FREE, tmp_path_factory.mktemp("clean"), "clean"))
 
 
-@needs_tie_robust_pulses
 def test_round_trip_recovers_amplitudes_and_delay_constant(tmp_path, noise_free):
     folder = run_virtual_experiment(ROUND_TRIP, tmp_path / "noisy", "virtual")
     _, pulses, selection, delays, fits = _analyse(folder)
@@ -307,7 +277,6 @@ def test_round_trip_recovers_amplitudes_and_delay_constant(tmp_path, noise_free)
     assert (delays.loc[delays["ok"], "delay_us"] < 0).all()  # crossed waves arrive early
 
 
-@needs_tie_robust_pulses
 def test_protocol_rejects_the_mismatched_shots(tmp_path):
     settings = dataclasses.replace(
         ROUND_TRIP,
