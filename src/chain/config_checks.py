@@ -1,11 +1,12 @@
 """Checks on a pipeline configuration that a JSON schema cannot express.
 
 The pipeline validates its config against ``workflow/schemas/config.schema.yaml``
-first (types, ranges, defaults), then calls :func:`check_config` for the relations
+first (types, ranges, defaults; snakemake.utils.validate names the key as
+``On instance['chains'][1]['N']``), then calls :func:`check_config` for the relations
 between keys (sensor beads inside their chain, the Fig. 3 model among the models...).
-Every message starts with the dotted name of the offending key, e.g.
-``config key 'chains[1].sensors': ...``, so that a bad config stops before any job
-runs and says where.
+Every message of :func:`check_config` starts with the dotted name of the offending
+key, e.g. ``config key 'chains[1].sensors': ...``, so that a bad config stops before
+any job runs and says where.
 
 The module takes plain dicts; it reads no file and knows nothing of Snakemake.
 """
@@ -36,22 +37,6 @@ def key_name(path: Iterable) -> str:
         else:
             name += f".{part}" if name else str(part)
     return name or "<top level>"
-
-
-def describe_validation_error(error) -> str:
-    """One line naming the key of a ``jsonschema.ValidationError``.
-
-    For a missing or unexpected key the name is taken from the message, so that
-    ``{'launch': {}}`` gives ``config key 'launch.count': ... is a required property``.
-    """
-    path = list(error.absolute_path)
-    message = error.message
-    if error.validator in ("required", "additionalProperties") and "'" in message:
-        missing = message.split("'")[1]
-        if error.validator == "required":
-            return f"config key {key_name([*path, missing])!r}: required key is missing"
-        return f"config key {key_name([*path, missing])!r}: unknown key ({message})"
-    return f"config key {key_name(path)!r}: {message}"
 
 
 def _fail(path, message: str):

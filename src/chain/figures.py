@@ -200,7 +200,7 @@ def _main_method(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def _us_n16(value: float) -> str:
-    return f"{value:.1f} µs N$^{{1/6}}$"
+    return f"{value:.2f} µs N$^{{1/6}}$"
 
 
 # ---- Fig. 1 ---------------------------------------------------------------------

@@ -51,12 +51,13 @@ def lib(*modules):
     return [str(LIB / f"{module}.py") for module in modules]
 
 
+# Each list: the modules the rule's script calls and what they import.
 LIB_SIMULATE = lib("materials", "model", "integrator", "simulation", "theory", "traces")
-LIB_PULSES = lib("traces", "theory", "pulses")
+LIB_PULSES = lib("materials", "traces", "pulses")
 LIB_DELAYS = LIB_PULSES + lib("regression", "delays")
-LIB_SSW = LIB_PULSES + lib("regression", "ssw")
-LIB_FIGURES = lib("figures", "theory", "materials", "summary")
-LIB_SUMMARY = lib("summary", "theory", "materials")
+LIB_SSW = LIB_DELAYS + lib("ssw")
+LIB_SUMMARY = lib("materials", "theory", "summary")
+LIB_FIGURES = LIB_SUMMARY + lib("traces", "figures")
 
 
 # ---- trace sources -------------------------------------------------------------

@@ -1,0 +1,395 @@
+"""Figure functions (chain.figures) on small synthetic tables: they return Figures,
+draw what the captions say, and save byte-identical PDF/PNG files."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.figure import Figure
+
+from chain import figures
+from chain.theory import cos6_pulse
+from chain.traces import sensor_column, validate_traces
+
+#: Synthetic pulse: duration tau and the arrival times of the incident and crossed
+#: pulses at S1 (the crossed pulse arrives DELAY early, the reference on time).
+TAU = 80e-6
+T_INCIDENT, T_CROSSED, T_REFERENCE_S2 = 400e-6, 800e-6, 810e-6
+DT = 2e-6
+DURATION = 1.6e-3
+FORCES_N = (20.0, 100.0, 300.0, 900.0)
+
+
+def synthetic_traces(n: int, sensors=(9, 17), source="simulation", model="elastic"):
+    """A trace table of one chain: a collision and a reference shot per amplitude."""
+    time = np.arange(0.0, DURATION, DT)
+    rows = []
+    for amplitude, force in enumerate(FORCES_N):
+        ssw = 0.05 * force * np.exp(-(((time - T_CROSSED - 1.2 * TAU) / (0.4 * TAU)) ** 2))
+        collision = cos6_pulse(time, force, T_INCIDENT, TAU) + cos6_pulse(
+            time, 0.95 * force, T_CROSSED, TAU
+        )
+        shots = {
+            ("collision", amplitude): (collision + ssw, collision + ssw),
+            ("reference", len(FORCES_N) + amplitude): (
+                cos6_pulse(time, force, T_INCIDENT, TAU),
+                cos6_pulse(time, 0.96 * force, T_REFERENCE_S2, TAU),
+            ),
+        }
+        for (kind, shot), (s1, s2) in shots.items():
+            rows.append(
+                pd.DataFrame(
+                    {
+                        "source": source,
+                        "model": model,
+                        "N": n,
+                        "shot": shot,
+                        "kind": kind,
+                        "amplitude": amplitude,
+                        "v0_left_m_s": 0.3 * (amplitude + 1),
+                        "v0_right_m_s": 0.3 * (amplitude + 1) if kind == "collision" else 0.0,
+                        "t_s": time,
+                        sensor_column(sensors[0]): s1,
+                        sensor_column(sensors[1]): s2,
+                    }
+                )
+            )
+    return validate_traces(pd.concat(rows, ignore_index=True))
+
+
+def synthetic_pulses(traces: pd.DataFrame, estimator="fit_full") -> pd.DataFrame:
+    rows = []
+    for shot, group in traces.groupby("shot"):
+        meta = group.iloc[0]
+        force = FORCES_N[int(meta["amplitude"])]
+        base = {
+            "source": meta["source"],
+            "model": meta["model"],
+            "N": meta["N"],
+            "shot": shot,
+            "kind": meta["kind"],
+            "amplitude": meta["amplitude"],
+            "estimator": estimator,
+            "tau_s": TAU,
+            "ok": True,
+            "reason": "",
+        }
+        if meta["kind"] == "collision":
+            for sensor, first, second in (("S1", "LSTW", "RSTW"), ("S2", "RSTW", "LSTW")):
+                rows.append(
+                    {
+                        **base,
+                        "sensor": sensor,
+                        "role": "incident",
+                        "wave": first,
+                        "F_m_N": force,
+                        "T_s": T_INCIDENT,
+                    }
+                )
+                rows.append(
+                    {
+                        **base,
+                        "sensor": sensor,
+                        "role": "crossed",
+                        "wave": second,
+                        "F_m_N": 0.95 * force,
+                        "T_s": T_CROSSED,
+                    }
+                )
+        else:
+            rows.append(
+                {
+                    **base,
+                    "sensor": "S1",
+                    "role": "reference",
+                    "wave": "LSTW",
+                    "F_m_N": force,
+                    "T_s": T_INCIDENT,
+                }
+            )
+            rows.append(
+                {
+                    **base,
+                    "sensor": "S2",
+                    "role": "reference",
+                    "wave": "LSTW",
+                    "F_m_N": 0.96 * force,
+                    "T_s": T_REFERENCE_S2,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def synthetic_ssw(pulses: pd.DataFrame) -> pd.DataFrame:
+    crossed = pulses[pulses["role"] == "crossed"]
+    table = crossed[["source", "model", "N", "shot", "amplitude", "sensor", "wave"]].copy()
+    table["F_m_N"] = crossed["F_m_N"] / 0.95
+    table["ssw_N"] = 0.05 * table["F_m_N"]
+    table["ssw_time_us"] = (T_CROSSED + 1.2 * TAU) * 1e6
+    table["method"] = "residual"
+    table["ok"] = True
+    return table
+
+
+def delays_table() -> pd.DataFrame:
+    rows = []
+    for source, model, c in (
+        ("simulation", "elastic", 40.0),
+        ("simulation", "viscoelastic", 43.0),
+        ("experiment", "rig", 46.0),
+    ):
+        for n in (25, 26):
+            for amplitude, force in enumerate(FORCES_N):
+                for wave in ("LSTW", "RSTW"):
+                    rows.append(
+                        {
+                            "source": source,
+                            "model": model,
+                            "N": n,
+                            "shot": amplitude,
+                            "amplitude": amplitude,
+                            "wave": wave,
+                            "estimator": "fit_full",
+                            "F_m_N": force * (1.02 if wave == "RSTW" else 1.0),
+                            "delay_us": -c * force ** (-1 / 6),
+                            "ok": True,
+                        }
+                    )
+    return pd.DataFrame(rows)
+
+
+def delay_fits_table() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "source": ["simulation", "simulation", "experiment", "simulation"],
+            "model": ["elastic", "viscoelastic", "rig", "elastic"],
+            "N": ["pooled", "pooled", "pooled", "25"],
+            "estimator": "fit_full",
+            "C_us_N16": [40.0, 43.0, 46.0, 40.0],
+            "C_stderr_us_N16": [0.2, 0.2, 0.6, 0.1],
+            "exponent": -1 / 6,
+            "exponent_stderr": 0.003,
+            "n_points": 16,
+        }
+    )
+
+
+def ssw_tables():
+    rows = []
+    for source, model in (("simulation", "elastic"), ("experiment", "rig")):
+        for n, slope in ((25, 0.02), (26, 0.05)):
+            for force in FORCES_N:
+                rows.append(
+                    {
+                        "source": source,
+                        "model": model,
+                        "N": n,
+                        "F_m_N": force,
+                        "ssw_N": slope * force,
+                        "method": "residual",
+                        "ok": True,
+                    }
+                )
+    ssw = pd.DataFrame(rows)
+    fits = ssw.groupby(["source", "model", "N"], as_index=False).apply(
+        lambda g: pd.Series(
+            {"slope": (g.ssw_N / g.F_m_N).mean(), "slope_stderr": 1e-4, "n_points": len(g)}
+        ),
+        include_groups=False,
+    )
+    fits["method"] = "residual"
+    return ssw, fits
+
+
+@pytest.fixture(scope="module")
+def trace_inputs():
+    t25 = synthetic_traces(25, (9, 17))
+    t26 = synthetic_traces(26, (10, 17))
+    pulses = pd.concat([synthetic_pulses(t25), synthetic_pulses(t26)], ignore_index=True)
+    return [t25, t26], pulses, synthetic_ssw(pulses)
+
+
+def line_styles(ax):
+    return [(line.get_color(), line.get_linestyle()) for line in ax.get_lines()]
+
+
+# ---- Fig. 1 --------------------------------------------------------------------------
+
+
+def test_fig1_draws_one_row_per_chain():
+    fig = figures.fig1_setup([{"N": 25, "sensors": [9, 17]}, {"N": 26, "sensors": [10, 17]}])
+    assert isinstance(fig, Figure)
+    axes = fig.get_axes()
+    assert len(axes) == 2
+    texts = [t.get_text() for t in axes[1].texts]
+    assert "S1 (n = 10)" in texts and "S2 (n = 17)" in texts
+    assert "LSTW" in texts and "RSTW" in texts
+    assert any("acquisition" in t for t in texts)
+    circles = [p for p in axes[0].patches if type(p).__name__ == "Circle"]
+    assert len(circles) == 25 + 2  # beads and strikers
+
+
+def test_fig1_subsamples_many_chains():
+    chains = [{"N": n, "sensors": [n // 2 - 3, n + 1 - (n // 2 - 3)]} for n in range(20, 32)]
+    fig = figures.fig1_setup(chains, max_rows=4)
+    assert len(fig.get_axes()) == 4
+    assert "4 of 12 chains" in fig.get_suptitle()
+
+
+# ---- Fig. 2 / 3 ----------------------------------------------------------------------
+
+
+def test_fig3_layout_and_styles(trace_inputs):
+    traces, pulses, ssw = trace_inputs
+    fig = figures.fig3_simulation_traces(
+        traces, pulses, ssw, model="elastic", representative_force_N=280
+    )
+    main = [ax for ax in fig.get_axes() if ax.get_title(loc="left")]
+    titles = sorted(ax.get_title(loc="left") for ax in main)
+    assert [t.split(")")[0] for t in titles] == ["(A", "(B", "(C", "(D"]
+    assert "N = 25, S1 at n = 9" in titles[0] and "F$_m$ = 300 N" in titles[0]
+    assert "N = 26, S2 at n = 17" in titles[3]
+    by_title = {ax.get_title(loc="left")[:3]: ax for ax in main}
+    s1_styles = line_styles(by_title["(A)"])
+    # reference dotted, then LSTW solid (incident) and RSTW dashed (crossed) at S1.
+    assert s1_styles == [
+        (figures.REFERENCE_COLOR, ":"),
+        (figures.LSTW_COLOR, "-"),
+        (figures.RSTW_COLOR, "--"),
+    ]
+    s2_styles = line_styles(by_title["(B)"])
+    assert s2_styles[1:] == [(figures.RSTW_COLOR, "--"), (figures.LSTW_COLOR, "-")]
+    insets = [inset for ax in main for inset in ax.child_axes]
+    assert len(insets) == 4
+    assert all(any("SSW 15 N" in t.get_text() for t in inset.texts) for inset in insets)
+
+
+def test_fig3_split_is_at_the_minimum_between_pulses(trace_inputs):
+    traces, pulses, _ = trace_inputs
+    fig = figures.fig3_simulation_traces(
+        traces[:1], pulses, None, model="elastic", representative_index=1, inset=False
+    )
+    ax = fig.get_axes()[0]
+    lstw = ax.get_lines()[1].get_xdata()
+    split_us = lstw[-1]
+    assert T_INCIDENT * 1e6 + TAU * 1e6 < split_us < T_CROSSED * 1e6 - TAU * 1e6
+    assert len(fig.get_axes()) == 2
+    assert not fig.get_axes()[0].child_axes
+
+
+def test_fig3_without_pulse_table_picks_by_peak(trace_inputs):
+    traces, _, _ = trace_inputs
+    fig = figures.fig3_simulation_traces(traces, model="elastic", representative_force_N=900)
+    ax = next(a for a in fig.get_axes() if a.get_title(loc="left"))
+    peak = max(np.max(line.get_ydata()) for line in ax.get_lines())
+    assert peak == pytest.approx(900.0, rel=0.01)
+
+
+def test_fig2_takes_experiment_traces(trace_inputs):
+    _, _, _ = trace_inputs
+    traces = synthetic_traces(25, (9, 17), source="experiment", model="rig")
+    pulses = synthetic_pulses(traces)
+    fig = figures.fig2_experiment_traces([traces], pulses, label="virtual experiment (model)")
+    assert fig.get_suptitle().startswith("virtual experiment (model)")
+    with pytest.raises(ValueError, match="no experiment traces"):
+        figures.fig2_experiment_traces([synthetic_traces(25)])
+
+
+# ---- Fig. 4 / 5 / parity -------------------------------------------------------------
+
+
+def test_fig4_lines_fits_and_references():
+    constants = {"C_bal_paper_us_N16": 49.75, "C_bal_exact_us_N16": 37.74}
+    fig = figures.fig4_delay_vs_force(
+        delays_table(),
+        delay_fits_table(),
+        constants=constants,
+        experiment_label="virtual experiment (model)",
+    )
+    ax = fig.get_axes()[0]
+    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+    assert "(N)" in ax.get_xlabel() and "(µs)" in ax.get_ylabel()
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert sum(label.startswith("simulation, ") for label in labels) == 4
+    assert "virtual experiment (model), N = 25" in labels
+    assert any(label.startswith("virtual experiment (model) fit: C = 46.0") for label in labels)
+    assert any("fit to simulation, elastic: C = 40.0 ± 0.2" in label for label in labels)
+    assert any("Eq. 6 as printed" in label and "49.75" in label for label in labels)
+    assert any("exact Hertz" in label and "37.74" in label for label in labels)
+    assert any("paper's experimental fit" in label and "45.9 ± 0.5" in label for label in labels)
+    markers = {line.get_label(): line for line in ax.get_lines()}
+    n25 = markers["virtual experiment (model), N = 25"]
+    assert n25.get_marker() == "o" and n25.get_markerfacecolor() == "none"
+    assert markers["virtual experiment (model), N = 26"].get_marker() == "x"
+    fits = [line for line in ax.get_lines() if "fit" in line.get_label()]
+    assert len(fits) == 4  # one per simulated model, the experiment's, the paper's C_exp
+    assert all(line.get_linestyle() == "--" for line in fits[:3])
+
+
+def test_fig4_on_given_axes():
+    fig = Figure()
+    ax = fig.add_subplot()
+    assert figures.fig4_delay_vs_force(delays_table(), ax=ax) is fig
+
+
+def test_fig5_filled_simulation_open_experiment():
+    ssw, fits = ssw_tables()
+    fig = figures.fig5_ssw_vs_force(ssw, fits, experiment_label="virtual experiment (model)")
+    ax = fig.get_axes()[0]
+    points = {line.get_label(): line for line in ax.get_lines() if line.get_linestyle() == "None"}
+    sim = points[next(k for k in points if k.startswith("simulation, elastic, N = 25"))]
+    exp = points[next(k for k in points if k.startswith("virtual experiment (model), N = 26"))]
+    assert sim.get_markerfacecolor() != "none"
+    assert exp.get_markerfacecolor() == "none"
+    assert "slope 5.00e-02" in exp.get_label()
+    assert ax.get_ylabel() == "SSW amplitude (N)"
+
+
+def test_parity_figure():
+    rows = [
+        {
+            "source": "simulation",
+            "model": "elastic",
+            "N": n,
+            "slope": 0.05 if n % 2 == 0 else 0.02,
+            "slope_stderr": 1e-3,
+            "n_points": 8,
+            "method": "residual",
+        }
+        for n in range(20, 32)
+    ]
+    fig = figures.fig_parity_ssw_vs_N(pd.DataFrame(rows))
+    labels = [t.get_text() for t in fig.get_axes()[0].get_legend().get_texts()]
+    assert labels == ["simulation, elastic, even N", "simulation, elastic, odd N"]
+
+
+# ---- saving --------------------------------------------------------------------------
+
+
+def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
+    traces, pulses, ssw = trace_inputs
+    paths = []
+    for name in ("a", "b"):
+        fig = figures.fig3_simulation_traces(traces, pulses, ssw, model="elastic")
+        paths.append(figures.save_figure(fig, tmp_path / name / "fig3_simulation_traces"))
+    for first, second in zip(*paths):
+        assert first.read_bytes() == second.read_bytes(), first.name
+    pdf, png = paths[0]
+    assert pdf.name == "fig3_simulation_traces.pdf" and pdf.read_bytes().startswith(b"%PDF")
+    assert png.read_bytes().startswith(b"\x89PNG")
+    assert b"CreationDate" not in pdf.read_bytes()
+    assert b"Software" not in png.read_bytes() and b"matplotlib" not in png.read_bytes().lower()
+    assert sorted(p.name for p in pdf.parent.iterdir()) == [pdf.name, png.name]
+    mode = pdf.stat().st_mode & 0o777
+    assert mode & 0o044, "figures must be readable by others (not left at mkstemp's 0600)"
+
+
+def test_model_colors_and_markers():
+    colors = figures.model_colors(["elastic", "viscoelastic", "custom"])
+    assert colors["elastic"] != colors["viscoelastic"] != colors["custom"]
+    assert figures.chain_marker(25) == "o" and figures.chain_marker(26) == "x"
+    assert figures.chain_marker(20, [20, 21]) != figures.chain_marker(21, [20, 21])
+    assert math.isfinite(figures.PNG_DPI)

@@ -1,0 +1,199 @@
+"""summary.json / summary.md (chain.summary) from synthetic tables."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from chain.summary import (
+    PAPER,
+    build_summary,
+    run_constants,
+    summary_json,
+    summary_markdown,
+    write_summary,
+)
+
+#: The paper's Eq. 6 value and our recomputation agree to the printed digits.
+CBAL_PAPER_ABS_US = 0.02
+
+#: Ratio exact / Eq. 6: 2^(-2/5) (reduced mass m/2 instead of m) x 2.9432/2.94.
+EXACT_OVER_PAPER = 2.0**-0.4 * 2.9432 / 2.94
+
+
+def delay_fits() -> pd.DataFrame:
+    rows = []
+    for model, c in (("elastic", 40.0), ("viscoelastic", 43.2)):
+        for n in (25, 26, "pooled"):
+            for estimator in ("fit_full", "peak"):
+                rows.append(
+                    {
+                        "source": "simulation",
+                        "model": model,
+                        "N": n,
+                        "estimator": estimator,
+                        "C_us_N16": c + (0.5 if estimator == "peak" else 0.0),
+                        "C_stderr_us_N16": 0.2,
+                        "exponent": -1 / 6,
+                        "exponent_stderr": 0.003,
+                        "n_points": 24,
+                        "prefactor_free_us": c,
+                    }
+                )
+    rows.append(
+        {**rows[0], "model": "rig", "source": "experiment", "N": "pooled", "C_us_N16": 46.0}
+    )
+    rows.append({**rows[0], "model": "rig", "source": "experiment", "N": 25, "C_us_N16": math.nan})
+    return pd.DataFrame(rows)
+
+
+def ssw_fits() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "source": "simulation",
+            "model": ["elastic", "elastic"],
+            "N": [25, 26],
+            "slope": [0.019, 0.047],
+            "slope_stderr": [2e-5, 3e-5],
+            "n_points": [24, 24],
+            "method": "residual",
+        }
+    )
+
+
+def runs() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "model": ["elastic", "elastic", "viscoelastic"],
+            "N": [25, 26, 25],
+            "energy_drift": [3e-10, 4e-10, 5e-6],
+        }
+    )
+
+
+@pytest.fixture()
+def summary() -> dict:
+    return build_summary(
+        run_name="paper",
+        material="steel_100C6",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=ssw_fits(),
+        runs=runs(),
+        conservative_models=["elastic"],
+    )
+
+
+def test_run_constants_match_eq6():
+    constants = run_constants("steel_100C6", 0.013)
+    assert abs(constants["C_bal_paper_us_N16"] - PAPER["C_bal_us_N16"]) < CBAL_PAPER_ABS_US
+    ratio = constants["C_bal_exact_us_N16"] / constants["C_bal_paper_us_N16"]
+    assert ratio == pytest.approx(EXACT_OVER_PAPER, rel=1e-4)
+    assert constants["bead_mass_kg"] == pytest.approx(4 / 3 * math.pi * 0.013**3 * 7780)
+    assert constants["kappa_N_m1_5"] > 0
+
+
+def test_contract_keys(summary):
+    for key in ("run_name", "constants", "paper", "max_energy_drift", "delay_fits", "ssw_fits"):
+        assert key in summary
+    assert set(summary["constants"]) >= {
+        "kappa_N_m1_5",
+        "bead_mass_kg",
+        "C_bal_paper_us_N16",
+        "C_bal_exact_us_N16",
+    }
+    assert summary["paper"] == {
+        "C_exp_us_N16": 45.9,
+        "C_exp_err_us_N16": 0.5,
+        "C_bal_us_N16": 49.74,
+    }
+    assert len(summary["delay_fits"]) == len(delay_fits())
+    assert len(summary["ssw_fits"]) == 2
+
+
+def test_max_energy_drift_is_over_conservative_runs_only(summary):
+    assert summary["max_energy_drift"] == pytest.approx(4e-10)
+    assert summary["energy_drift_by_model"]["viscoelastic"] == pytest.approx(5e-6)
+    none = build_summary(
+        run_name="x",
+        material="steel_100C6",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=ssw_fits(),
+        runs=runs(),
+        conservative_models=[],
+    )
+    assert none["max_energy_drift"] is None
+
+
+def test_json_is_sorted_fixed_and_nan_free(summary):
+    text = summary_json(summary)
+    assert text.endswith("\n")
+    data = json.loads(text)
+    assert list(data) == sorted(data)
+    assert "NaN" not in text
+    nan_row = [r for r in data["delay_fits"] if r["source"] == "experiment" and r["N"] == 25]
+    assert nan_row[0]["C_us_N16"] is None
+    pooled = [r["N"] for r in data["delay_fits"] if not isinstance(r["N"], int)]
+    assert set(pooled) == {"pooled"}
+    assert summary_json(json.loads(text)) == text, "writing twice gives the same bytes"
+
+
+def test_json_floats_have_fixed_precision():
+    table = ssw_fits()
+    table.loc[0, "slope"] = 1 / 3
+    data = build_summary(
+        run_name="x",
+        material="steel_100C6",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=table,
+    )
+    assert data["ssw_fits"][0]["slope"] == 0.3333333333
+    assert isinstance(data["ssw_fits"][0]["n_points"], int)
+
+
+def test_markdown_table(summary):
+    text = summary_markdown(summary)
+    assert "| quantity | paper | this run | note |" in text
+    assert "49.74" in text and "45.9 ± 0.5" in text
+    assert "reduced mass m/2" in text  # why the exact C_bal differs from Eq. 6
+    assert "C, simulation, elastic, all N pooled, fit_full" in text
+    assert "C, simulation, viscoelastic, N = 26, peak" in text
+    assert "exponent p" in text
+    assert "SSW slope, simulation, elastic, N = 26" in text
+    assert "2.47 × the N = 25 slope" in text
+    assert "C(viscoelastic) / C(elastic)" in text and "1.080" in text
+    assert "4.00e-10" in text
+    assert "rig: 46.0" in text  # the experiment's own pooled C
+    assert "nan" not in text.lower().replace("nan ", "")
+    rows = [line for line in text.splitlines() if line.startswith("| ")]
+    assert all(line.count(" | ") == 3 for line in rows)
+
+
+def test_markdown_other_material():
+    data = build_summary(
+        run_name="brass",
+        material="brass",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=ssw_fits(),
+    )
+    text = summary_markdown(data)
+    assert "not the paper's beads" in text
+    assert "n/a (no conservative model)" in text
+
+
+def test_write_summary(tmp_path, summary):
+    json_path, md_path = tmp_path / "out" / "summary.json", tmp_path / "out" / "summary.md"
+    write_summary(summary, json_path, md_path)
+    first = json_path.read_bytes(), md_path.read_bytes()
+    write_summary(summary, json_path, md_path)
+    assert (json_path.read_bytes(), md_path.read_bytes()) == first
+    assert sorted(p.name for p in json_path.parent.iterdir()) == ["summary.json", "summary.md"]
+    assert json.loads(first[0])["run_name"] == "paper"
+    assert np.isclose(json.loads(first[0])["max_energy_drift"], 4e-10)
