@@ -21,11 +21,11 @@ from chain.theory import hertz_contact_time
 from chain.traces import META_COLUMNS, sensor_column
 
 #: Steps per shortest two-body contact time in the default time step. The exact
-#: Hertz scaling makes the energy drift a function of dt / t_c only; 3000 keeps the
-#: conservative drift of the paper's N = 26 chain below 1e-9 over 2.6 ms up to
-#: 1 m/s (RK4 loses order at the delta^(3/2) kink when a contact opens, hence the
-#: many steps).
-STEPS_PER_CONTACT_TIME = 3000
+#: Hertz scaling makes the energy drift a function of dt / t_c only; 1000 keeps the
+#: conservative drift of the paper's N = 26 chain near 3e-10 over 2.6 ms at any launch
+#: speed (RK4's own truncation error; the steps where a contact opens or closes are
+#: refined by the integrator, see chain.integrator.EVENT_SUBSTEPS).
+STEPS_PER_CONTACT_TIME = 1000
 
 #: Steps per period of the stiffest bonded spring (sensor beads) in the default step.
 STEPS_PER_SPRING_PERIOD = 400
