@@ -185,6 +185,8 @@ def test_markdown_other_material():
     )
     text = summary_markdown(data)
     assert "not the paper's beads" in text
+    assert "— (the paper's beads are steel_100C6)" in text
+    assert "vs paper's C_exp" not in text  # no comparison with measurements on steel
     assert "n/a (no conservative model)" in text
 
 

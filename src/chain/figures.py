@@ -253,10 +253,7 @@ def fig1_setup(
             "(beads numbered 1..N from the left)"
         )
         if len(shown) < len(chains):
-            title += (
-                f"; {len(shown)} of {len(chains)} chains shown "
-                f"(N = {', '.join(str(c['N']) for c in chains)})"
-            )
+            title += f"; {len(shown)} of {len(chains)} chains shown"
         fig.suptitle(title, fontsize=8)
     return fig
 
@@ -264,13 +261,13 @@ def fig1_setup(
 def _draw_chain(ax, n: int, sensors: list[int], radius: float, striker: float, span: float):
     centers = radius * (2 * np.arange(1, n + 1) - 1)
     gap = 2.5 * radius
+    length = 2 * radius * n
     left = -gap - 2 * striker
-    right = span + gap + 2 * striker
+    right = span + gap + 2 * striker  # common to all rows: the same scale in every row
+    end = length + gap + 2 * striker  # this chain's right striker
     # Track (Plexiglas) under the beads.
     ax.add_patch(
-        Rectangle(
-            (left + striker, -radius - 4), right - left - 2 * striker, 4, color="#cfe3ef", lw=0
-        )
+        Rectangle((left + striker, -radius - 4), end - left - 2 * striker, 4, color="#cfe3ef", lw=0)
     )
     ax.text(left + striker, -radius - 6, "track", ha="left", va="top", fontsize=6, color="#4a6f86")
     for number, x in enumerate(centers, start=1):
@@ -289,7 +286,7 @@ def _draw_chain(ax, n: int, sensors: list[int], radius: float, striker: float, s
         elif number in (1, n) or number % 5 == 0:
             ax.text(x, 0, str(number), ha="center", va="center", fontsize=5.5, color="#303030")
     # Strikers, moving towards the chain.
-    for side, x0, direction in ((0, -gap - striker, 1), (1, span + gap + striker, -1)):
+    for side, x0, direction in ((0, -gap - striker, 1), (1, length + gap + striker, -1)):
         ax.add_patch(Circle((x0, 0), striker, facecolor="#808080", edgecolor="black", lw=0.6))
         ax.add_patch(
             FancyArrowPatch(
@@ -304,7 +301,7 @@ def _draw_chain(ax, n: int, sensors: list[int], radius: float, striker: float, s
         label = "+V$_0$" if side == 0 else "−V$_0$"
         ax.text(x0, striker + 3, f"striker\n{label}", ha="center", va="bottom", fontsize=6)
     # Waves.
-    arrow_y = radius + 9
+    arrow_y = radius + 19
     for name, start, stop, color in (
         ("LSTW", centers[1], centers[min(5, n - 1)], LSTW_COLOR),
         ("RSTW", centers[-2], centers[max(n - 6, 0)], RSTW_COLOR),
@@ -372,7 +369,7 @@ def _draw_chain(ax, n: int, sensors: list[int], radius: float, striker: float, s
             lw=0.7,
         )
     ax.text(
-        right,
+        end,
         -radius - 6,
         f"N = {n}",
         ha="right",
