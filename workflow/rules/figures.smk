@@ -9,6 +9,8 @@ rule fig1_setup:
         **figure_outputs("fig1_setup"),
     log:
         f"{LOGS}/figures/fig1_setup.log",
+    benchmark:
+        f"{BENCH}/figures/fig1_setup.tsv"
     conda:
         ENV
     params:
@@ -32,6 +34,8 @@ rule fig2_experiment_traces:
         **figure_outputs("fig2_experiment_traces"),
     log:
         f"{LOGS}/figures/fig2_experiment_traces.log",
+    benchmark:
+        f"{BENCH}/figures/fig2_experiment_traces.tsv"
     conda:
         ENV
     params:
@@ -57,6 +61,8 @@ rule fig3_simulation_traces:
         **figure_outputs("fig3_simulation_traces"),
     log:
         f"{LOGS}/figures/fig3_simulation_traces.log",
+    benchmark:
+        f"{BENCH}/figures/fig3_simulation_traces.tsv"
     conda:
         ENV
     params:
@@ -78,6 +84,8 @@ rule fig4_delay_vs_force:
         **figure_outputs("fig4_delay_vs_force"),
     log:
         f"{LOGS}/figures/fig4_delay_vs_force.log",
+    benchmark:
+        f"{BENCH}/figures/fig4_delay_vs_force.tsv"
     conda:
         ENV
     params:
@@ -98,6 +106,8 @@ rule fig5_ssw_vs_force:
         **figure_outputs("fig5_ssw_vs_force"),
     log:
         f"{LOGS}/figures/fig5_ssw_vs_force.log",
+    benchmark:
+        f"{BENCH}/figures/fig5_ssw_vs_force.tsv"
     conda:
         ENV
     params:
@@ -114,6 +124,8 @@ rule fig_parity_ssw_vs_N:
         **figure_outputs("fig_parity_ssw_vs_N"),
     log:
         f"{LOGS}/figures/fig_parity_ssw_vs_N.log",
+    benchmark:
+        f"{BENCH}/figures/fig_parity_ssw_vs_N.tsv"
     conda:
         ENV
     params:

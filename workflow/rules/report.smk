@@ -14,6 +14,8 @@ rule summary:
         ),
     log:
         f"{LOGS}/summary.log",
+    benchmark:
+        f"{BENCH}/summary.tsv"
     conda:
         ENV
     params:
