@@ -312,7 +312,7 @@ def test_fig4_lines_fits_and_references():
     ax = fig.get_axes()[0]
     assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
     assert "(N)" in ax.get_xlabel() and "(µs)" in ax.get_ylabel()
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert sum(label.startswith("simulation, ") for label in labels) == 4
     assert "virtual experiment (model), N = 25" in labels
     assert any(label.startswith("virtual experiment (model) fit: C = 46.0") for label in labels)
@@ -333,6 +333,7 @@ def test_fig4_on_given_axes():
     fig = Figure()
     ax = fig.add_subplot()
     assert figures.fig4_delay_vs_force(delays_table(), ax=ax) is fig
+    assert ax.get_legend() is not None and not fig.legends
 
 
 def test_fig5_filled_simulation_open_experiment():
@@ -362,7 +363,7 @@ def test_parity_figure():
         for n in range(20, 32)
     ]
     fig = figures.fig_parity_ssw_vs_N(pd.DataFrame(rows))
-    labels = [t.get_text() for t in fig.get_axes()[0].get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert labels == ["simulation, elastic, even N", "simulation, elastic, odd N"]
 
 

@@ -85,6 +85,7 @@ def summary() -> dict:
         ssw_fits=ssw_fits(),
         runs=runs(),
         conservative_models=["elastic"],
+        experiment_label="virtual experiment (model)",
     )
 
 
@@ -170,6 +171,7 @@ def test_markdown_table(summary):
     assert "C(viscoelastic) / C(elastic)" in text and "1.080" in text
     assert "4.00e-10" in text
     assert "rig: 46.0" in text  # the experiment's own pooled C
+    assert "C, virtual experiment (model), rig, all N pooled, fit_full" in text
     assert "nan" not in text.lower().replace("nan ", "")
     rows = [line for line in text.splitlines() if line.startswith("| ")]
     assert all(line.count(" | ") == 3 for line in rows)

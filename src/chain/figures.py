@@ -153,6 +153,20 @@ def _axes(ax, width=4.8, height=3.6):
         return fig, fig.add_subplot()
 
 
+def _legend(fig, ax, own: bool, loc: str) -> None:
+    """Below the axes on a figure of our own (never over the data); inside otherwise."""
+    if own:
+        fig.legend(
+            *ax.get_legend_handles_labels(),
+            loc="outside lower center",
+            ncol=2,
+            fontsize=6,
+            frameon=False,
+        )
+    else:
+        ax.legend(loc=loc, fontsize=6, frameon=False)
+
+
 def model_colors(models: Sequence[str]) -> dict[str, str]:
     """A colour per model name: fixed for elastic/viscoelastic, the cycle otherwise."""
     colors = {}
@@ -786,7 +800,8 @@ def fig4_delay_vs_force(
     ax : Axes, optional
         Draw here instead of on a new figure.
     """
-    fig, ax = _axes(ax, 5.2, 4.2)
+    own = ax is None
+    fig, ax = _axes(ax, 6.4, 5.4)
     rows = delays[(delays["estimator"] == estimator) & _as_bool(delays["ok"])].copy()
     rows["abs_delay_us"] = rows["delay_us"].abs()
     models = list(dict.fromkeys(rows.loc[rows["source"] == "simulation", "model"]))
@@ -890,7 +905,7 @@ def fig4_delay_vs_force(
         ax.set_xlabel("incident amplitude F$_m$ at the first sensor (N)")
         ax.set_ylabel("|Δ| = |TOF(crossed) − TOF(reference)| (µs)")
         ax.set_title(f"Crossing delay against amplitude ({estimator} estimator)", loc="left")
-        ax.legend(loc="lower left", fontsize=6, frameon=False)
+        _legend(fig, ax, own, "lower left")
     return fig
 
 
@@ -920,7 +935,8 @@ def fig5_ssw_vs_force(
     ax : Axes, optional
         Draw here instead of on a new figure.
     """
-    fig, ax = _axes(ax, 5.2, 4.2)
+    own = ax is None
+    fig, ax = _axes(ax, 6.4, 5.0)
     ssw = _main_method(ssw)
     rows = ssw[_as_bool(ssw["ok"]) & (ssw["ssw_N"] > 0) & (ssw["F_m_N"] > 0)]
     models = list(dict.fromkeys(rows.loc[rows["source"] == "simulation", "model"]))
@@ -967,7 +983,7 @@ def fig5_ssw_vs_force(
         ax.set_title(
             "Secondary solitary waves: simulation filled, experiment open markers", loc="left"
         )
-        ax.legend(loc="upper left", fontsize=6, frameon=False)
+        _legend(fig, ax, own, "upper left")
     return fig
 
 
@@ -993,7 +1009,8 @@ def fig_parity_ssw_vs_N(
     ax : Axes, optional
         Draw here instead of on a new figure.
     """
-    fig, ax = _axes(ax, 5.2, 3.8)
+    own = ax is None
+    fig, ax = _axes(ax, 6.0, 4.4)
     ssw_fits = _main_method(ssw_fits)
     rows = ssw_fits[~_is_pooled(ssw_fits["N"])].copy()
     rows["N"] = rows["N"].astype(int)
@@ -1028,5 +1045,5 @@ def fig_parity_ssw_vs_N(
             "Parity: even chains (waves meet at a contact) against odd (at a bead)", loc="left"
         )
         ax.xaxis.set_major_locator(mpl.ticker.MaxNLocator(integer=True))
-        ax.legend(fontsize=6, frameon=False)
+        _legend(fig, ax, own, "best")
     return fig

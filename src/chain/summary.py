@@ -108,6 +108,7 @@ def build_summary(
     runs: pd.DataFrame | None = None,
     conservative_models: Iterable[str] = ("elastic",),
     main_estimator: str = "fit_full",
+    experiment_label: str = "experiment",
 ) -> dict:
     """The contents of ``summary.json``.
 
@@ -129,6 +130,9 @@ def build_summary(
         Models without dissipation, whose energy drift measures the integration error.
     main_estimator : str
         Estimator of the headline numbers.
+    experiment_label : str
+        Name of ``source == "experiment"`` rows in summary.md ("virtual experiment
+        (model)" for the model of the apparatus).
 
     Returns
     -------
@@ -155,6 +159,7 @@ def build_summary(
             "material": material,
             "radius_m": radius_m,
             "main_estimator": main_estimator,
+            "experiment_label": experiment_label,
             "conservative_models": sorted(conservative),
             "constants": run_constants(material, radius_m),
             "paper": dict(PAPER),
@@ -186,10 +191,11 @@ def _pm(value, error, digits=2) -> str:
     return f"{value:.{decimals}f} ± {error:.{decimals}f}"
 
 
-def _who(row: Mapping) -> str:
+def _who(row: Mapping, experiment_label: str = "experiment") -> str:
     n = row["N"]
     chains = "all N pooled" if n == "pooled" else f"N = {n}"
-    return f"{row['source']}, {row['model']}, {chains}"
+    source = experiment_label if row["source"] == "experiment" else row["source"]
+    return f"{source}, {row['model']}, {chains}"
 
 
 def summary_markdown(summary: Mapping) -> str:
@@ -203,6 +209,7 @@ def summary_markdown(summary: Mapping) -> str:
     paper = summary["paper"]
     constants = summary["constants"]
     main = summary["main_estimator"]
+    label = summary.get("experiment_label", "experiment")
     c_exp, c_exp_err, c_bal = (
         paper["C_exp_us_N16"],
         paper["C_exp_err_us_N16"],
@@ -265,7 +272,7 @@ def summary_markdown(summary: Mapping) -> str:
                 note = f"{_percent(c, c_exp)} vs paper's C_exp, " + note
         rows.append(
             (
-                f"C, {_who(row)}, {row['estimator']} (µs N^1/6)",
+                f"C, {_who(row, label)}, {row['estimator']} (µs N^1/6)",
                 f"{c_exp:.1f} ± {c_exp_err:.1f} (experiment)"
                 if steel
                 else "— (the paper's beads are steel_100C6)",
@@ -280,7 +287,9 @@ def summary_markdown(summary: Mapping) -> str:
         note = "free power law |Δ| = A F_m^p"
         if p is not None and err:
             note += f"; {(p + 1 / 6) / err:+.1f} standard errors from −1/6"
-        rows.append((f"exponent p, {_who(row)}, {main}", "−1/6 (Eq. 6)", _pm(p, err, 4), note))
+        rows.append(
+            (f"exponent p, {_who(row, label)}, {main}", "−1/6 (Eq. 6)", _pm(p, err, 4), note)
+        )
     rows += _dissipation_rows(summary, main)
     slopes = {
         (r["source"], r["model"], r["N"]): r
@@ -299,7 +308,7 @@ def summary_markdown(summary: Mapping) -> str:
             paper_text += "; simulated SSW much smaller than measured"
         rows.append(
             (
-                f"SSW slope, {_who(row)}",
+                f"SSW slope, {_who(row, label)}",
                 paper_text,
                 _pm(row.get("slope"), row.get("slope_stderr"), 4)
                 if row.get("slope") is not None

@@ -16,6 +16,7 @@ summary = build_summary(
     runs=pd.concat([pd.read_csv(path) for path in snakemake.input.runs], ignore_index=True),
     conservative_models=p.conservative_models,
     main_estimator=p.estimator,
+    experiment_label=p.experiment_label,
 )
 write_summary(summary, snakemake.output.json, snakemake.output.md)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
