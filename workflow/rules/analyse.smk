@@ -27,7 +27,7 @@ rule pulses:
 rule delays:
     input:
         pulses=f"{TABLES}/pulses.csv",
-        selection=SELECTION,
+        selection=selection_files,
         lib=LIB_DELAYS,
     output:
         f"{TABLES}/delays.csv",
@@ -65,7 +65,7 @@ rule ssw:
     input:
         traces=all_trace_files,
         pulses=f"{TABLES}/pulses.csv",
-        selection=SELECTION,
+        selection=selection_files,
         lib=LIB_SSW,
     output:
         f"{TABLES}/ssw.csv",

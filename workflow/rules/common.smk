@@ -62,15 +62,31 @@ LIB_FIGURES = LIB_SUMMARY + lib("traces", "figures")
 
 # ---- trace sources -------------------------------------------------------------
 # A "part" is one trace file: (source, model, N). The simulation gives one per
-# model and chain; the analysis reads them all. Experiment traces (virtual or measured, issue 5) plug in by
-# appending to EXPERIMENT_PARTS in workflow/rules/experiment.smk and providing
-# results/<run>/experiment/<model>_N<N>_traces.csv (+ SELECTION, if any).
+# model and chain; the analysis reads them all.
 SIMULATION_PARTS = [("simulation", model, n) for model in MODELS for n in CHAINS]
+
+# Experiment traces (virtual or measured, issue 5) plug in here, from a rule file
+# workflow/rules/experiment.smk included in the Snakefile (anywhere after common.smk:
+# everything below is read through functions, at DAG time):
+#   * rules writing trace_file("experiment", <dataset>, N) (chain.traces format) for
+#     each chain, and append ("experiment", <dataset>, N) to EXPERIMENT_PARTS;
+#   * optionally a rule writing chain.protocol.select_shots' table, its path appended
+#     to SELECTION (the delay and SSW tables then drop rejected collision shots);
+#   * EXPERIMENT_LABEL = "virtual experiment (model)" when the traces come from the
+#     model of the apparatus (figures and summary.md name the series with it);
+#   * its config keys added to workflow/schemas/config.schema.yaml.
+# Then Fig. 2 joins rule all, and Fig. 4/5 and the summary show the experiment series.
 EXPERIMENT_PARTS = []
-# Files of chain.protocol.select_shots, passed to the delay and SSW tables.
 SELECTION = []
-# Label of experiment series in figures ("virtual experiment (model)" for a model).
 EXPERIMENT_LABEL = "experiment"
+
+
+def selection_files(wildcards):
+    return list(SELECTION)
+
+
+def experiment_label(wildcards):
+    return EXPERIMENT_LABEL
 
 
 def trace_file(source, model, n):

@@ -43,7 +43,7 @@ rule fig2_experiment_traces:
         representative_force_N=config["figures"]["representative_force_N"],
         representative_index=config["figures"]["representative_index"],
         estimator=config["analysis"]["main_estimator"],
-        label=EXPERIMENT_LABEL,
+        label=experiment_label,
     script:
         "../scripts/fig_traces.py"
 
@@ -92,7 +92,7 @@ rule fig4_delay_vs_force:
         material=config["material"],
         radius_m=config["radius_m"],
         estimator=config["analysis"]["main_estimator"],
-        experiment_label=EXPERIMENT_LABEL,
+        experiment_label=experiment_label,
     script:
         "../scripts/fig4_delay_vs_force.py"
 
@@ -111,7 +111,7 @@ rule fig5_ssw_vs_force:
     conda:
         ENV
     params:
-        experiment_label=EXPERIMENT_LABEL,
+        experiment_label=experiment_label,
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -129,6 +129,6 @@ rule fig_parity_ssw_vs_N:
     conda:
         ENV
     params:
-        experiment_label=EXPERIMENT_LABEL,
+        experiment_label=experiment_label,
     script:
         "../scripts/fig_parity_ssw_vs_N.py"

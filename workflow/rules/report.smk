@@ -24,7 +24,7 @@ rule summary:
         radius_m=config["radius_m"],
         conservative_models=CONSERVATIVE,
         estimator=config["analysis"]["main_estimator"],
-        experiment_label=EXPERIMENT_LABEL,
+        experiment_label=experiment_label,
     script:
         "../scripts/summary.py"
 
