@@ -26,6 +26,9 @@ commands:
   analyse    fit the pulses of a trace file (cos^6 fits) and print them as CSV
   theory     print the closed forms for a material: kappa, bead mass, C_bal (Eq. 6),
              C_bal with the exact Hertz contact time, wave speed (Eq. 5)
+  check      check a pipeline run: every contract file present, headline numbers
+             (C, exponents, SSW slopes, C_bal, energy drift) within tolerance of a
+             committed reference
 
 Beads are numbered 1..N as in the paper. Units: SI (m, s, m/s, N).
 Example:
@@ -132,7 +135,57 @@ def _build_parser() -> argparse.ArgumentParser:
     theory.add_argument(
         "--force", type=float, default=100.0, help="peak force F_m for the wave speed, N"
     )
+    check = commands.add_parser(
+        "check",
+        help="check a run against the results contract and a reference",
+        description="Check results/<run_name>: contract files and columns, and the headline "
+        "numbers of summary.json against a reference file within its tolerances. "
+        "Exit status 1 lists every failure.",
+    )
+    check.add_argument("run_folder", help="results/<run_name>")
+    check.add_argument(
+        "--reference", required=True, help="reference JSON (tests/reference/paper_headline.json)"
+    )
+    check.add_argument(
+        "--no-experiment", action="store_true", help="the run has no experiment side (no Fig. 2)"
+    )
+    check.add_argument(
+        "--write-reference",
+        metavar="WHY",
+        default=None,
+        help="instead of checking, (re)write the reference from this run, recording WHY; "
+        "commit it only in a reviewed commit that says why",
+    )
     return parser
+
+
+def _check(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from chain import headline
+
+    folder = Path(args.run_folder)
+    summary_path = folder / "summary.json"
+    if not summary_path.is_file():
+        raise FileNotFoundError(f"{summary_path}: no summary; run the pipeline first")
+    summary = json.loads(summary_path.read_text())
+    if args.write_reference is not None:
+        reference = headline.reference_from_summary(summary, args.write_reference)
+        Path(args.reference).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.reference).write_text(json.dumps(reference, indent=2, sort_keys=True) + "\n")
+        print(f"wrote {args.reference} ({len(reference['values'])} numbers)")
+        return 0
+    reference = json.loads(Path(args.reference).read_text())
+    failures = headline.missing_contract_files(folder, experiment=not args.no_experiment)
+    failures += headline.compare_with_reference(headline.headline_numbers(summary), reference)
+    for failure in failures:
+        print(f"FAIL {failure}")
+    checked = len(reference["values"])
+    if failures:
+        print(f"{len(failures)} problem(s); {checked} headline numbers in the reference")
+        return 1
+    print(f"ok: contract files present, {checked} headline numbers within tolerance")
+    return 0
 
 
 def _simulate(args: argparse.Namespace) -> int:
@@ -211,7 +264,7 @@ def _theory(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``hertzchain`` console script; returns the exit status."""
     args = _build_parser().parse_args(argv)
-    handlers = {"simulate": _simulate, "analyse": _analyse, "theory": _theory}
+    handlers = {"simulate": _simulate, "analyse": _analyse, "theory": _theory, "check": _check}
     try:
         return handlers[args.command](args)
     except (ParameterError, TraceFormatError, IntegrationError, FileNotFoundError) as error:

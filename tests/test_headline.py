@@ -1,0 +1,130 @@
+"""The CI check of headline numbers and contract files (chain.headline)."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import pandas as pd
+import pytest
+
+from chain import headline
+from chain.cli import main
+
+
+def _summary() -> dict:
+    fit = {
+        "source": "simulation",
+        "model": "elastic",
+        "N": 25,
+        "estimator": "fit_full",
+        "C_us_N16": 41.43,
+        "C_stderr_us_N16": 0.01,
+        "exponent": -0.16667,
+        "exponent_stderr": 1e-5,
+        "n_points": 24,
+    }
+    return {
+        "run_name": "paper",
+        "constants": {
+            "C_bal_paper_us_N16": 49.7469,
+            "C_bal_exact_us_N16": 37.7413,
+            "kappa_N_m1_5": 1.199e10,
+            "bead_mass_kg": 0.0716,
+        },
+        "paper": {"C_exp_us_N16": 45.9, "C_exp_err_us_N16": 0.5, "C_bal_us_N16": 49.74},
+        "max_energy_drift": 5e-10,
+        "delay_fits": [fit, {**fit, "source": "experiment", "model": "virtual", "C_us_N16": 44.0}],
+        "ssw_fits": [
+            {
+                "source": "simulation",
+                "model": "elastic",
+                "N": 25,
+                "slope": 0.0192,
+                "method": "residual",
+            }
+        ],
+    }
+
+
+def test_a_run_matches_its_own_reference():
+    """A reference made from a summary accepts that summary."""
+    summary = _summary()
+    reference = headline.reference_from_summary(summary, "test")
+    assert headline.compare_with_reference(headline.headline_numbers(summary), reference) == []
+
+
+@pytest.mark.parametrize(
+    ("change", "fragment"),
+    [
+        (
+            lambda s: s["delay_fits"][0].update(C_us_N16=41.43 * 1.01),
+            "C_us_N16/simulation/elastic/N=25",
+        ),
+        (lambda s: s["delay_fits"][0].update(exponent=-0.160), "exponent/simulation/elastic"),
+        (lambda s: s["ssw_fits"][0].update(slope=0.0192 * 1.05), "ssw_slope/simulation/elastic"),
+        (lambda s: s["constants"].update(C_bal_paper_us_N16=49.8), "C_bal/paper_form"),
+        (lambda s: s.update(max_energy_drift=2e-9), "max_energy_drift"),
+        (lambda s: s["delay_fits"].pop(1), "in the reference but not produced"),
+        (lambda s: s["delay_fits"][0].update(C_us_N16=float("nan")), "not a number"),
+    ],
+)
+def test_a_drifted_headline_number_fails_by_name(change, fragment):
+    """Moving one headline number beyond its tolerance gives a failure naming it."""
+    summary = _summary()
+    reference = headline.reference_from_summary(summary, "test")
+    drifted = copy.deepcopy(summary)
+    change(drifted)
+    failures = headline.compare_with_reference(headline.headline_numbers(drifted), reference)
+    assert len(failures) == 1
+    assert fragment in failures[0]
+
+
+def test_experiment_numbers_get_the_looser_tolerance():
+    """A 1 % move of the (noisy) experiment C is within tolerance; of the simulation C not."""
+    summary = _summary()
+    reference = headline.reference_from_summary(summary, "test")
+    drifted = copy.deepcopy(summary)
+    drifted["delay_fits"][1]["C_us_N16"] *= 1.01
+    assert headline.compare_with_reference(headline.headline_numbers(drifted), reference) == []
+
+
+def _write_run(folder, summary):
+    for name in headline.CONTRACT_FIGURES + headline.EXPERIMENT_FIGURES:
+        for suffix in (".pdf", ".png"):
+            path = folder / "figures" / f"{name}{suffix}"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(b"x")
+    (folder / "tables").mkdir()
+    for name, columns in headline.CONTRACT_TABLES.items():
+        pd.DataFrame(columns=list(columns) or ["shot"]).to_csv(
+            folder / "tables" / name, index=False
+        )
+    (folder / "summary.json").write_text(json.dumps(summary))
+    (folder / "summary.md").write_text("# summary\n")
+
+
+def test_contract_check_names_missing_files_and_columns(tmp_path):
+    """Every contract file is required, and a table without its columns is reported."""
+    _write_run(tmp_path, _summary())
+    assert headline.missing_contract_files(tmp_path) == []
+    (tmp_path / "figures" / "fig4_delay_vs_force.png").unlink()
+    pd.DataFrame(columns=["source", "model"]).to_csv(tmp_path / "tables" / "ssw_fits.csv")
+    problems = headline.missing_contract_files(tmp_path)
+    assert any("fig4_delay_vs_force.png" in p for p in problems)
+    assert any("ssw_fits.csv" in p and "slope" in p for p in problems)
+
+
+def test_cli_check_exit_status(tmp_path, capsys):
+    """`hertzchain check` exits 0 on a matching run and 1 listing failures otherwise."""
+    run = tmp_path / "run"
+    run.mkdir()
+    _write_run(run, _summary())
+    reference = tmp_path / "reference.json"
+    assert main(["check", str(run), "--reference", str(reference), "--write-reference", "t"]) == 0
+    assert main(["check", str(run), "--reference", str(reference)]) == 0
+    drifted = _summary()
+    drifted["delay_fits"][0]["C_us_N16"] = 50.0
+    (run / "summary.json").write_text(json.dumps(drifted))
+    assert main(["check", str(run), "--reference", str(reference)]) == 1
+    assert "C_us_N16/simulation/elastic/N=25/fit_full" in capsys.readouterr().out
