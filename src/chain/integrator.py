@@ -54,7 +54,7 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
     return elastic, total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _derivatives(u, v, params, acc, link_force):
     """Accelerations into ``acc``, link forces into ``link_force``; returns
     (left wall force, right wall force, dissipated power, closed Hertz contacts)."""
@@ -145,7 +145,7 @@ def _record(u, v, dissipated, params, acc, link_force, sample, outputs):
     out_momentum[sample] = momentum
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _rk4_step(u, v, dt, params, work):
     """One classical RK4 step of (u, v) in place; returns the dissipated energy and
     whether the number of closed contacts varied between the stages (a contact event
