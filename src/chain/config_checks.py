@@ -3,19 +3,88 @@
 The pipeline validates its config against ``workflow/schemas/config.schema.yaml``
 first (types, ranges, defaults; snakemake.utils.validate names the key as
 ``On instance['chains'][1]['N']``), then calls :func:`check_config` for the relations
-between keys (sensor beads inside their chain, the Fig. 3 model among the models...).
-Every message of :func:`check_config` starts with the dotted name of the offending
-key, e.g. ``config key 'chains[1].sensors': ...``, so that a bad config stops before
-any job runs and says where.
+between keys (sensor beads inside their chain, the Fig. 3 model among the models, a
+duration long enough for the waves, the virtual experiment's settings...) and, when the
+experiment reads measured datasets, :func:`experiment_datasets` for their metadata.
+Every message starts with the dotted name of the offending key, e.g.
+``config key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config
+stops before any job runs and says where.
 
-The module takes plain dicts; it reads no file and knows nothing of Snakemake.
+:func:`check_config` takes a plain dict and reads no file; :func:`experiment_datasets`
+reads the datasets' ``metadata.yaml`` (and nothing else). Neither knows Snakemake.
+
+Duration check
+--------------
+A record must be long enough for the slowest wave to pass the sensor farthest from
+its launching end (S2 for the LSTW, S1 for the RSTW): at distance
+d = 2R max(S2 - 1, N - S1), the whole pulse has passed at d / v + (pi/2) tau, with v
+the solitary-wave speed of Eq. 5 and tau = R sqrt(10) / v (Eq. 4) for the smallest
+incident amplitude. That amplitude is estimated from the launch momentum:
+
+* simulation (bead 1 launched at V0): F_m = F(V_m) of Eq. 5 with
+  V_m = :data:`LAUNCH_VELOCITY_RATIO` x V0 (measured 0.47 in the paper's chains: F_m =
+  1030 N at V0 = 1 m/s; the ratio is the same for every material and radius by the
+  scaling symmetry of the Hertz chain);
+* virtual experiment (striker of mass m_s at V0): V_m = ratio x (m_s / m) x V0, the
+  striker's momentum m_s V0 being a lower bound of what it hands to the chain (it
+  bounces back); for the paper's 4 mm strikers this gives 4.7 N at 0.4 m/s where the
+  virtual experiment measures 10 N: the estimate errs on the slow side (12 % in speed).
+
+The duration must exceed :data:`DURATION_MARGIN` times that time. The paper run passes
+with 2.6 ms against 1.9 ms (simulation, 0.021 m/s, N = 26) and 2.2 ms (virtual
+experiment, 0.4 m/s). The SSW search after the crossed pulse (6 tau) is cut at the end of
+the record when it is shorter; that is not an error.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+import math
+import os
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
 
-from chain.materials import MATERIALS
+from chain.materials import MATERIALS, ParameterError, get_material
+from chain.theory import force_from_bead_velocity, nesterenko_speed_from_force, pulse_half_width
+
+#: V_m / V0 of the solitary wave formed when bead 1 of a free chain is launched at V0
+#: (0.47 measured: F_m = 1030 N at 1 m/s in the paper's chains); a little lower, so that
+#: the estimated wave is, if anything, too slow.
+LAUNCH_VELOCITY_RATIO = 0.45
+
+#: The duration must be this many times the time the slowest pulse needs to pass the
+#: far sensor (see the module docstring).
+DURATION_MARGIN = 1.2
+
+#: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
+SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+
+#: Name of the virtual experiment's series when experiment.name is null.
+VIRTUAL_SERIES = "virtual"
+
+#: Label of the virtual experiment's rows in figures and summary (not data).
+VIRTUAL_LABEL = "virtual experiment (model)"
+
+#: Config key of experiment.virtual -> field of chain.experiment.VirtualExperiment.
+VIRTUAL_FIELDS = {
+    "eta_s": "eta",
+    "drag_rate_per_s": "drag_rate",
+    "sensor_stiffness_N_per_m": "sensor_stiffness",
+    "sensitivity_mV_per_N": "sensitivity_mV_per_N",
+    "impact_speeds_m_s": "impact_speeds_m_s",
+    "drop_heights_m": "drop_heights_m",
+    "collision_shots": "collision_shots",
+    "reference_shots": "reference_shots",
+    "speed_mismatch": "speed_mismatch",
+    "timing_jitter_s": "timing_jitter_s",
+    "noise_N": "noise_N",
+    "sampling_interval_s": "sampling_interval_s",
+    "adc_bits": "adc_bits",
+    "adc_range_V": "adc_range_V",
+    "duration_s": "duration_s",
+    "time_step_s": "time_step_s",
+}
 
 
 class ConfigError(ValueError):
@@ -43,6 +112,184 @@ def _fail(path, message: str):
     raise ConfigError(f"config key {key_name(path)!r}: {message}")
 
 
+def pulse_passing_time(
+    material: str,
+    radius_m: float,
+    n_beads: int,
+    sensors: Sequence[int],
+    v0_m_s: float,
+    mass_ratio: float = 1.0,
+) -> dict[str, float]:
+    """When the slowest pulse has passed the far sensor (the duration check).
+
+    Parameters
+    ----------
+    material : str
+        Bead material name.
+    radius_m : float
+        Bead radius R, m.
+    n_beads : int
+        Number of beads N.
+    sensors : sequence of int
+        Sensor beads [S1, S2].
+    v0_m_s : float
+        Launch speed of the slowest wave, m/s (bead 1's, or the striker's).
+    mass_ratio : float
+        Launcher mass over bead mass (1 when bead 1 itself is launched).
+
+    Returns
+    -------
+    dict
+        ``force_N`` (estimated incident F_m), ``speed_m_s`` (Eq. 5), ``tau_s`` (Eq. 4),
+        ``distance_m`` (launching end to the far sensor), ``bead`` (that sensor) and
+        ``time_s`` = distance / speed + (pi/2) tau.
+    """
+    beads = get_material(material)
+    s1, s2 = sensors[0], sensors[-1]
+    bead, beads_away = (s2, s2 - 1) if s2 - 1 >= n_beads - s1 else (s1, n_beads - s1)
+    distance = 2.0 * radius_m * beads_away
+    force = force_from_bead_velocity(LAUNCH_VELOCITY_RATIO * mass_ratio * v0_m_s, beads, radius_m)
+    speed = nesterenko_speed_from_force(force, beads, radius_m)
+    tau = pulse_half_width(force, beads, radius_m)
+    return {
+        "force_N": force,
+        "speed_m_s": speed,
+        "tau_s": tau,
+        "distance_m": distance,
+        "bead": bead,
+        "time_s": distance / speed + 0.5 * math.pi * tau,
+    }
+
+
+def _check_duration(path, duration, config, v0, mass_ratio, what) -> None:
+    worst = None
+    for entry in config["chains"]:
+        passing = pulse_passing_time(
+            config["material"], config["radius_m"], entry["N"], entry["sensors"], v0, mass_ratio
+        )
+        if worst is None or passing["time_s"] > worst[1]["time_s"]:
+            worst = (entry["N"], passing)
+    n, passing = worst
+    needed = DURATION_MARGIN * passing["time_s"]
+    if duration < needed:
+        _fail(
+            path,
+            f"{duration:g} s is too short: the slowest wave ({what} at V0 = {v0:g} m/s: F_m ~ "
+            f"{passing['force_N']:.3g} N, Eq. 5 speed {passing['speed_m_s']:.0f} m/s) has "
+            f"passed bead {passing['bead']} of the N = {n} chain, {passing['distance_m']:.3g} m "
+            f"from its launching end, at ~{passing['time_s'] * 1e3:.3g} ms; allowed: >= "
+            f"{DURATION_MARGIN:g} x that = {needed:.3g} s (or faster launches)",
+        )
+
+
+def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence[int]) -> dict:
+    """The :class:`chain.experiment.VirtualExperiment` fields for one chain of a config.
+
+    Material and radius are the run's, the striker radius ``setup.striker_radius_m``,
+    the seed the top-level seed + N (so that the chains' shots differ), the rest
+    ``experiment.virtual`` renamed by :data:`VIRTUAL_FIELDS`.
+
+    Parameters
+    ----------
+    config : mapping
+        A schema-valid config (defaults filled in).
+    n_beads : int
+        N.
+    sensors : sequence of int
+        Sensor beads [S1, S2].
+
+    Returns
+    -------
+    dict
+        Plain values (lists for tuples), ready for ``VirtualExperiment.from_dict``.
+    """
+    virtual = config.get("experiment", {}).get("virtual", {})
+    settings = {VIRTUAL_FIELDS[key]: value for key, value in virtual.items()}
+    settings.update(
+        n_beads=int(n_beads),
+        sensor_beads=[int(b) for b in sensors],
+        material=config["material"],
+        radius=config["radius_m"],
+        striker_radius=config.get("setup", {}).get("striker_radius_m", 0.004),
+        seed=int(config.get("seed", 0)) + int(n_beads),
+    )
+    return settings
+
+
+def _check_experiment(config: Mapping) -> None:
+    experiment = config.get("experiment", {})
+    source = experiment.get("source", "none")
+    datasets = experiment.get("datasets", [])
+    if source == "measured" and not datasets:
+        _fail(
+            ["experiment", "datasets"],
+            "source: measured needs at least one dataset folder (data/README.md format), "
+            "e.g. [data/lab2011_N25, data/lab2011_N26]",
+        )
+    if source != "measured" and datasets:
+        _fail(
+            ["experiment", "datasets"],
+            f"dataset folders are read only with source: measured (source is {source!r}); "
+            "empty the list or set experiment.source: measured",
+        )
+    if source != "virtual":
+        return
+    virtual = experiment.get("virtual", {})
+    base = ["experiment", "virtual"]
+    if virtual.get("impact_speeds_m_s") is not None and virtual.get("drop_heights_m") is not None:
+        _fail(
+            [*base, "drop_heights_m"],
+            "give impact_speeds_m_s or drop_heights_m, not both (set the other to null)",
+        )
+    duration = virtual.get("duration_s", 0.0)
+    sampling = virtual.get("sampling_interval_s", 1.0)
+    if duration < 10 * sampling:
+        _fail(
+            [*base, "duration_s"],
+            f"{duration:g} s holds fewer than 10 samples of sampling_interval_s = {sampling:g} s",
+        )
+    step = virtual.get("time_step_s")
+    if step is not None and step > sampling:
+        _fail(
+            [*base, "time_step_s"],
+            f"{step:g} s is longer than sampling_interval_s = {sampling:g} s; allowed: "
+            "<= the sampling interval, or null",
+        )
+    # Imported here: chain.experiment pulls in the simulation core.
+    from chain.experiment import VirtualExperiment
+
+    settings = None
+    for entry in config["chains"]:
+        try:
+            settings = VirtualExperiment.from_dict(
+                virtual_experiment_settings(config, entry["N"], entry["sensors"])
+            )
+        except ParameterError as error:
+            _fail(base, f"{error} (chain N = {entry['N']})")
+    speeds = settings.nominal_speeds
+    beads = get_material(config["material"])
+    mass_ratio = (settings.striker_radius / settings.radius) ** 3
+    _check_duration(
+        [*base, "duration_s"],
+        duration,
+        config,
+        float(min(speeds)),
+        mass_ratio,
+        f"strikers of {settings.striker_radius * 1e3:g} mm, momentum >= m_s V0,",
+    )
+    # Largest pulse: a striker that bounces back hands the chain at most 2 m_s V0.
+    v_m = LAUNCH_VELOCITY_RATIO * 2.0 * mass_ratio * float(max(speeds))
+    largest = force_from_bead_velocity(v_m, beads, config["radius_m"])
+    volts = largest * max(settings.sensitivities) / 1000.0
+    if settings.adc_bits is not None and volts >= settings.adc_range_V:
+        _fail(
+            [*base, "adc_range_V"],
+            f"{settings.adc_range_V:g} V: the largest pulse (~{largest:.3g} N at "
+            f"{max(speeds):g} m/s) reads ~{volts:.3g} V and would saturate the ADC; allowed: "
+            f"> {volts:.3g} V (or slower strikers, or adc_bits: null)",
+        )
+
+
 def check_config(config: Mapping) -> None:
     """Check the relations between keys of a schema-valid config.
 
@@ -64,28 +311,45 @@ def check_config(config: Mapping) -> None:
     for i, entry in enumerate(config["chains"]):
         n = entry["N"]
         if n in seen_n:
-            _fail(["chains", i, "N"], f"N = {n} is listed twice (also chains[{seen_n[n]}])")
+            _fail(
+                ["chains", i, "N"],
+                f"N = {n} is listed twice (also chains[{seen_n[n]}]); allowed: each N once",
+            )
         seen_n[n] = i
         s1, s2 = entry["sensors"]
         for j, bead in enumerate((s1, s2)):
             if not 1 <= bead <= n:
-                _fail(["chains", i, "sensors", j], f"bead {bead} is outside the chain 1..{n}")
+                _fail(
+                    ["chains", i, "sensors", j],
+                    f"bead {bead} is outside the chain; allowed: beads 1..{n}",
+                )
         if not s1 < s2:
-            _fail(["chains", i, "sensors"], f"S1 must be left of S2 (S1 < S2), got {[s1, s2]}")
+            _fail(
+                ["chains", i, "sensors"],
+                f"got {[s1, s2]}; allowed: S1 left of S2 (S1 < S2; S1 is met first by the LSTW)",
+            )
 
     names = [m["name"] for m in config["models"]]
     for i, name in enumerate(names):
         if name in names[:i]:
-            _fail(["models", i, "name"], f"model name {name!r} is listed twice")
+            _fail(
+                ["models", i, "name"],
+                f"model name {name!r} is listed twice; allowed: each name once (file names)",
+            )
 
     launch = config["launch"]
     if launch["v0_min_m_s"] > launch["v0_max_m_s"]:
         _fail(
             ["launch", "v0_min_m_s"],
-            f"{launch['v0_min_m_s']} m/s is above v0_max_m_s = {launch['v0_max_m_s']} m/s",
+            f"{launch['v0_min_m_s']} m/s is above v0_max_m_s = {launch['v0_max_m_s']} m/s; "
+            "allowed: v0_min_m_s <= v0_max_m_s",
         )
     if launch["count"] > 1 and launch["v0_min_m_s"] == launch["v0_max_m_s"]:
-        _fail(["launch", "count"], "several launch speeds need v0_min_m_s < v0_max_m_s")
+        _fail(
+            ["launch", "count"],
+            f"{launch['count']} launch speeds need v0_min_m_s < v0_max_m_s; allowed: count 1 "
+            "when they are equal",
+        )
 
     simulation = config.get("simulation", {})
     step = simulation.get("time_step_s")
@@ -93,17 +357,31 @@ def check_config(config: Mapping) -> None:
     if step is not None and record is not None and step > record:
         _fail(
             ["simulation", "time_step_s"],
-            f"{step} s is longer than record_interval_s = {record} s",
+            f"{step:g} s is longer than record_interval_s = {record:g} s; allowed: <= the "
+            "record interval, or null",
         )
     duration = simulation.get("duration_s")
     if duration is not None and record is not None and duration < 10 * record:
-        _fail(["simulation", "duration_s"], f"{duration} s holds fewer than 10 samples")
+        _fail(
+            ["simulation", "duration_s"],
+            f"{duration:g} s holds fewer than 10 samples of record_interval_s = {record:g} s; "
+            f"allowed: >= {10 * record:g} s",
+        )
+    if duration is not None:
+        _check_duration(
+            ["simulation", "duration_s"],
+            duration,
+            config,
+            launch["v0_min_m_s"],
+            1.0,
+            "bead 1 launched",
+        )
 
     analysis = config.get("analysis", {})
     if analysis.get("main_estimator") not in analysis.get("estimators", [None]):
         _fail(
             ["analysis", "main_estimator"],
-            f"{analysis.get('main_estimator')!r} is not among analysis.estimators "
+            f"{analysis.get('main_estimator')!r} is not among analysis.estimators; allowed: "
             f"{analysis.get('estimators')}",
         )
 
@@ -111,14 +389,145 @@ def check_config(config: Mapping) -> None:
     if figures.get("traces_model") not in names:
         _fail(
             ["figures", "traces_model"],
-            f"{figures.get('traces_model')!r} is not a configured model; models: {names}",
+            f"{figures.get('traces_model')!r} is not a configured model; allowed: {names}",
         )
     for j, n in enumerate(figures.get("traces_N") or []):
         if n not in seen_n:
-            _fail(["figures", "traces_N", j], f"N = {n} is not a configured chain")
+            _fail(
+                ["figures", "traces_N", j],
+                f"N = {n} is not a configured chain; allowed: {sorted(seen_n)}",
+            )
     index = figures.get("representative_index")
     if index is not None and index >= launch["count"]:
         _fail(
             ["figures", "representative_index"],
-            f"{index} is not an amplitude index 0..{launch['count'] - 1}",
+            f"{index} is not an amplitude index; allowed: 0..{launch['count'] - 1} "
+            "(launch.count speeds)",
         )
+
+    _check_experiment(config)
+
+
+@dataclass(frozen=True)
+class ExperimentPart:
+    """One chain of the experiment: where its traces come from.
+
+    Attributes
+    ----------
+    name : str
+        Series name (the ``model`` column; chains of one name are pooled in the fits).
+    n_beads : int
+        N.
+    sensor_beads : tuple of int
+        Sensor beads, S1 first.
+    folder : str or None
+        The measured dataset folder; None for the virtual experiment (its folder is a
+        pipeline output).
+    files : tuple of str
+        ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
+    virtual : bool
+        Whether the traces come from the virtual experiment (a model, not data),
+        including a measured-format dataset that it wrote.
+    """
+
+    name: str
+    n_beads: int
+    sensor_beads: tuple[int, ...]
+    folder: str | None = None
+    files: tuple[str, ...] = ()
+    virtual: bool = True
+
+
+def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[ExperimentPart]:
+    """The chains of a config's experiment, reading measured datasets' metadata.
+
+    Parameters
+    ----------
+    config : mapping
+        A config that passed :func:`check_config`.
+    root : path
+        Folder that relative dataset paths start from (the working directory).
+
+    Returns
+    -------
+    list of ExperimentPart
+        Empty with ``experiment.source: none``; one per configured chain for the
+        virtual experiment; one per dataset for measured datasets.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong
+        (the loader's message, with file and line), its name is not usable in file
+        names, or two datasets give the same name and N.
+    """
+    # Imported here: chain.measured reads files; check_config does not need it.
+    from chain.measured import MeasuredDataError, read_metadata
+
+    experiment = config.get("experiment", {})
+    source = experiment.get("source", "none")
+    name = experiment.get("name")
+    if source == "virtual":
+        return [
+            ExperimentPart(name or VIRTUAL_SERIES, int(c["N"]), tuple(c["sensors"]))
+            for c in config["chains"]
+        ]
+    if source != "measured":
+        return []
+    parts: list[ExperimentPart] = []
+    seen: dict[tuple[str, int], int] = {}
+    for i, folder in enumerate(experiment.get("datasets", [])):
+        path = ["experiment", "datasets", i]
+        where = Path(folder) if Path(folder).is_absolute() else Path(root) / folder
+        try:
+            meta = read_metadata(where)
+        except MeasuredDataError as error:
+            _fail(path, f"{error}")
+        series = name or meta.name or where.resolve().name
+        if not SERIES_NAME.match(series):
+            _fail(
+                path,
+                f"dataset name {series!r} (metadata name, else folder name) is not usable "
+                "in file names; allowed: letters, digits, '_', '-', starting with a "
+                "letter; set experiment.name",
+            )
+        key = (series, meta.n_beads)
+        if key in seen:
+            _fail(
+                path,
+                f"gives the series {series!r} with N = {meta.n_beads} again (as "
+                f"experiment.datasets[{seen[key]}]); allowed: one dataset per name and N",
+            )
+        seen[key] = i
+        parts.append(
+            ExperimentPart(
+                name=series,
+                n_beads=meta.n_beads,
+                sensor_beads=tuple(meta.sensor_beads),
+                folder=str(folder),
+                files=(
+                    str(Path(folder) / "metadata.yaml"),
+                    *(str(Path(folder) / shot.file) for shot in meta.shots),
+                ),
+                virtual=VIRTUAL_LABEL in (meta.description or ""),
+            )
+        )
+    return parts
+
+
+def experiment_label(parts: Sequence[ExperimentPart]) -> str:
+    """How figures and the summary name the experiment series.
+
+    ``"virtual experiment (model)"`` for the virtual experiment run by the pipeline;
+    ``"measured (<names>)"`` for measured datasets, and ``"virtual experiment (model):
+    <names>"`` for a measured-format dataset that the virtual experiment wrote (it is
+    still not data).
+    """
+    if not parts:
+        return "experiment"
+    if all(part.folder is None for part in parts):
+        return VIRTUAL_LABEL
+    names = ", ".join(dict.fromkeys(part.name for part in parts))
+    if all(part.virtual for part in parts):
+        return f"{VIRTUAL_LABEL}: {names}"
+    return f"measured ({names})"
