@@ -164,12 +164,12 @@ def delays_table() -> pd.DataFrame:
 def delay_fits_table() -> pd.DataFrame:
     return pd.DataFrame(
         {
-            "source": ["simulation", "simulation", "experiment", "simulation"],
-            "model": ["elastic", "viscoelastic", "rig", "elastic"],
-            "N": ["pooled", "pooled", "pooled", "25"],
+            "source": ["simulation", "simulation", "experiment", "simulation", "experiment"],
+            "model": ["elastic", "viscoelastic", "rig", "elastic", "rig"],
+            "N": ["pooled", "pooled", "pooled", "25", "25"],
             "estimator": "fit_full",
-            "C_us_N16": [40.0, 43.0, 46.0, 40.0],
-            "C_stderr_us_N16": [0.2, 0.2, 0.6, 0.1],
+            "C_us_N16": [40.0, 43.0, 46.0, 40.0, 46.1],
+            "C_stderr_us_N16": [0.2, 0.2, 0.6, 0.1, 0.8],
             "exponent": -1 / 6,
             "exponent_stderr": 0.003,
             "n_points": 16,
@@ -298,6 +298,49 @@ def test_fig2_takes_experiment_traces(trace_inputs):
         figures.fig2_experiment_traces([synthetic_traces(25)])
 
 
+def test_fig2_draws_a_shot_the_protocol_kept(trace_inputs):
+    traces = synthetic_traces(25, (9, 17), source="experiment", model="rig")
+    pulses = synthetic_pulses(traces)
+    # The collision nearest 300 N (amplitude 2, shot 2) was rejected: the nearest
+    # amplitude with a kept collision is drawn instead.
+    selection = pd.DataFrame(
+        {
+            "source": "experiment",
+            "model": "rig",
+            "N": 25,
+            "shot": sorted(traces["shot"].unique()),
+        }
+    )
+    selection["kept"] = selection["shot"] != 2
+    fig = figures.fig2_experiment_traces(
+        [traces], pulses, representative_force_N=300.0, selection=selection, label="lab"
+    )
+    title = next(ax.get_title(loc="left") for ax in fig.get_axes() if ax.get_title(loc="left"))
+    assert "F$_m$ = 100 N" in title or "F$_m$ = 900 N" in title
+    everything = figures.fig2_experiment_traces([traces], pulses, representative_force_N=300.0)
+    title = next(
+        ax.get_title(loc="left") for ax in everything.get_axes() if ax.get_title(loc="left")
+    )
+    assert "F$_m$ = 300 N" in title
+    assert everything.get_suptitle() == "experiment: forces at the sensor beads (series rig)"
+
+
+def test_trace_inset_stays_clear_of_the_traces(trace_inputs):
+    """A short record fills the width with the two pulses: the y axis makes room."""
+    traces = synthetic_traces(25, (9, 17), source="experiment", model="rig")
+    short = traces[traces["t_s"] < 1.0e-3]
+    pulses = synthetic_pulses(short)
+    fig = figures.fig2_experiment_traces([short], pulses, ssw=synthetic_ssw(pulses))
+    fig.draw_without_rendering()  # final positions (constrained layout)
+    for ax in (a for a in fig.get_axes() if a.get_title(loc="left")):
+        (inset,) = ax.child_axes
+        box = inset.get_window_extent()
+        for line in ax.get_lines():
+            points = ax.transData.transform(np.column_stack(line.get_data()))
+            under = (points[:, 0] >= box.x0) & (points[:, 0] <= box.x1)
+            assert np.all(points[under, 1] < box.y0), ax.get_title(loc="left")
+
+
 # ---- Fig. 4 / 5 / parity -------------------------------------------------------------
 
 
@@ -314,19 +357,55 @@ def test_fig4_lines_fits_and_references():
     assert "(N)" in ax.get_xlabel() and "(µs)" in ax.get_ylabel()
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert sum(label.startswith("simulation, ") for label in labels) == 4
-    assert "virtual experiment (model), N = 25" in labels
-    assert any(label.startswith("virtual experiment (model) fit: C = 46.0") for label in labels)
+    # Experiment markers carry their chain's own fit; the dashed line is the pooled fit.
+    assert "virtual experiment (model), N = 25 (own fit C = 46.1 ± 0.8)" in labels
+    assert "virtual experiment (model), N = 26" in labels
+    assert any(
+        label.startswith("fit to virtual experiment (model), N pooled: C = 46.0 ± 0.6")
+        for label in labels
+    )
     assert any("fit to simulation, elastic: C = 40.0 ± 0.2" in label for label in labels)
     assert any("Eq. 6 as printed" in label and "49.75" in label for label in labels)
     assert any("exact Hertz" in label and "37.74" in label for label in labels)
     assert any("paper's experimental fit" in label and "45.9 ± 0.5" in label for label in labels)
     markers = {line.get_label(): line for line in ax.get_lines()}
-    n25 = markers["virtual experiment (model), N = 25"]
+    n25 = markers["virtual experiment (model), N = 25 (own fit C = 46.1 ± 0.8)"]
     assert n25.get_marker() == "o" and n25.get_markerfacecolor() == "none"
     assert markers["virtual experiment (model), N = 26"].get_marker() == "x"
-    fits = [line for line in ax.get_lines() if "fit" in line.get_label()]
+    fits = [
+        line for line in ax.get_lines() if " fit" in line.get_label() or "fit " in line.get_label()
+    ]
+    fits = [line for line in fits if line.get_linestyle() != "None"]
     assert len(fits) == 4  # one per simulated model, the experiment's, the paper's C_exp
     assert all(line.get_linestyle() == "--" for line in fits[:3])
+
+
+def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog):
+    delays = delays_table()
+    experiment = delays.index[delays["source"] == "experiment"]
+    delays.loc[experiment[:3], "ok"] = False  # flagged
+    delays.loc[experiment[3], "delay_us"] = math.nan  # ok but NaN: a bug upstream
+    with caplog.at_level("INFO", logger="chain.summary"):
+        fig = figures.fig4_delay_vs_force(delays, experiment_label="x")
+    drawn = sum(
+        len(line.get_xdata())
+        for line in fig.get_axes()[0].get_lines()
+        if line.get_label().startswith("x, N = ")
+    )
+    assert drawn == len(experiment) - 4
+    assert "Fig. 4 (fit_full): 4 of 48 left out (3 flagged ok = False, 1 ok but NaN" in caplog.text
+
+    ssw, fits = ssw_tables()
+    ssw.loc[0, "ok"] = False
+    ssw.loc[1, "ssw_N"] = math.nan
+    ssw.loc[2, "ssw_N"] = -0.1  # below the noise: not on a log axis
+    caplog.clear()
+    with caplog.at_level("INFO", logger="chain.summary"):
+        fig = figures.fig5_ssw_vs_force(ssw, fits)
+    points = [line for line in fig.get_axes()[0].get_lines() if line.get_linestyle() == "None"]
+    assert sum(len(line.get_xdata()) for line in points) == len(ssw) - 3
+    assert "Fig. 5 SSW rows: 3 of 16 left out (1 flagged ok = False, 1 ok but NaN" in caplog.text
+    assert "1 <= 0 on a log axis" in caplog.text
 
 
 def test_fig4_on_given_axes():

@@ -201,3 +201,87 @@ def test_write_summary(tmp_path, summary):
     assert sorted(p.name for p in json_path.parent.iterdir()) == ["summary.json", "summary.md"]
     assert json.loads(first[0])["run_name"] == "paper"
     assert np.isclose(json.loads(first[0])["max_energy_drift"], 4e-10)
+
+
+# ---- guard rails: flagged rows, selection counts -------------------------------------
+
+
+def delays_with_flags() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "source": ["simulation"] * 3 + ["experiment"] * 4,
+            "model": ["elastic"] * 3 + ["rig"] * 4,
+            "N": 25,
+            "F_m_N": [10.0, 20.0, 30.0, 10.0, math.nan, 30.0, 40.0],
+            "delay_us": [-20.0, -18.0, -17.0, math.nan, math.nan, -17.0, -16.0],
+            "ok": [True, True, True, False, False, True, True],
+        }
+    )
+
+
+def test_usable_rows_drops_flagged_and_nan_and_logs_the_count(caplog):
+    from chain.summary import usable_rows
+
+    table = delays_with_flags()
+    table.loc[6, "delay_us"] = math.nan  # ok, but NaN: must not pass quietly
+    with caplog.at_level("INFO", logger="chain.summary"):
+        kept = usable_rows(table, ["F_m_N", "delay_us"], "delay rows")
+    assert list(kept.index) == [0, 1, 2, 5]
+    assert "delay rows: 3 of 7 left out (2 flagged ok = False, 1 ok but NaN/inf" in caplog.text
+    text = table.assign(ok=table["ok"].map({True: "True", False: "False"}))
+    assert list(usable_rows(text, ["F_m_N"]).index) == [0, 1, 2, 5, 6]
+    positive = usable_rows(table, ["delay_us"], positive=True)
+    assert positive.empty
+
+
+def test_flag_and_selection_counts_in_summary():
+    selection = pd.DataFrame(
+        {
+            "source": "experiment",
+            "model": "rig",
+            "N": [25, 25, 25, 26, 26],
+            "shot": [0, 1, 2, 0, 1],
+            "kind": ["collision", "collision", "reference", "collision", "reference"],
+            "kept": [True, False, True, True, True],
+        }
+    )
+    data = build_summary(
+        run_name="x",
+        material="steel_100C6",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=ssw_fits(),
+        delays=delays_with_flags(),
+        selection=selection,
+        tolerance=0.05,
+        experiment_label="measured (rig)",
+    )
+    assert data["flagged"]["delays"] == {
+        "experiment": {"rows": 4, "flagged": 2, "nan": 0},
+        "simulation": {"rows": 3, "flagged": 0, "nan": 0},
+    }
+    assert data["flagged"]["pulses"] == {}
+    assert data["selection"] == [
+        {"model": "rig", "N": 25, "kind": "collision", "kept": 1, "rejected": 1},
+        {"model": "rig", "N": 25, "kind": "reference", "kept": 1, "rejected": 0},
+        {"model": "rig", "N": 26, "kind": "collision", "kept": 1, "rejected": 0},
+        {"model": "rig", "N": 26, "kind": "reference", "kept": 1, "rejected": 0},
+    ]
+    assert data["experiment_tolerance"] == 0.05
+    text = summary_markdown(data)
+    assert (
+        "| acceptance protocol, measured (rig) | collisions kept if the incident amplitudes "
+        "differ by ≤ 5 % (Sec. IV); no counts printed | N = 25: 1 of 2 collisions kept, 1 of 1 "
+        "references kept; N = 26: 1 of 1 collisions kept, 1 of 1 references kept |"
+    ) in text
+    assert "delays: 0 of 3 (simulation), 2 of 4 (measured (rig))" in text
+    # The label names the series: no "rig" twice.
+    assert "C, measured (rig), all N pooled, fit_full" in text
+    assert "| 45.9 ± 0.5 | measured (rig): 46.00 ± 0.20 |" in text  # beside the paper's C_exp
+    assert json.loads(summary_json(data))["selection"][0]["kept"] == 1
+
+
+def test_no_experiment_no_selection_rows(summary):
+    text = summary_markdown(summary)
+    assert "acceptance protocol" not in text
+    assert summary["selection"] == [] and summary["experiment_tolerance"] is None

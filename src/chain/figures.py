@@ -38,7 +38,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, FancyArrowPatch, FancyBboxPatch, Rectangle
 
-from chain.summary import PAPER
+from chain.summary import PAPER, usable_rows
 from chain.traces import sensor_beads, sensor_column
 
 #: Resolution of the PNG files, dots per inch.
@@ -411,13 +411,21 @@ def fig2_experiment_traces(
     estimator: str = "fit_full",
     label: str = "experiment",
     inset: bool = True,
+    selection: pd.DataFrame | None = None,
 ) -> Figure:
     """Fig. 2: experiment forces at S1 and S2, (A, B) N = 25, (C, D) N = 26.
 
     Same layout and notation as :func:`fig3_simulation_traces`; ``traces`` are
     experiment trace tables (``source == "experiment"``, virtual or measured), and
     ``label`` names them (``"virtual experiment (model)"`` for the model of the
-    apparatus). Parameters as in :func:`fig3_simulation_traces`.
+    apparatus). Parameters as in :func:`fig3_simulation_traces`, and:
+
+    Parameters
+    ----------
+    selection : DataFrame, optional
+        ``experiment/selection.csv`` (:func:`chain.protocol.select_shots`): the
+        collision shot drawn is the first one the acceptance protocol kept, from the
+        amplitudes that have one. None: the first collision shot.
     """
     return _trace_figure(
         traces,
@@ -430,6 +438,7 @@ def fig2_experiment_traces(
         estimator=estimator,
         title=f"{label}: forces at the sensor beads",
         inset=inset,
+        selection=selection,
     )
 
 
@@ -508,7 +517,10 @@ def _split_by_chain(traces, source: str, model: str | None) -> dict[int, pd.Data
     return dict(sorted(chains.items()))
 
 
-def _pick_amplitude(table, pulses, source, n, estimator, target_force, index):
+def _pick_amplitude(table, pulses, source, n, estimator, target_force, index, kept=None):
+    """Amplitude index to draw: ``index``, else the one whose mean incident F_m at S1 is
+    nearest ``target_force`` on a log scale (the largest or smallest if the target is
+    out of range), among the amplitudes in ``kept`` when given."""
     if index is not None:
         return int(index)
     first = sensor_column(sensor_beads(table)[0])
@@ -530,7 +542,11 @@ def _pick_amplitude(table, pulses, source, n, estimator, target_force, index):
     if forces is None:
         collision = table[table["kind"] == "collision"]
         forces = collision.groupby("amplitude")[first].max()
-    forces = forces[forces > 0]
+    forces = forces[np.isfinite(forces) & (forces > 0)]
+    if kept is not None and forces.index.isin(kept).any():
+        forces = forces[forces.index.isin(kept)]
+    if forces.empty:
+        raise ValueError(f"N = {n}: no {source} amplitude with a positive incident F_m")
     return int((np.log(forces / target_force)).abs().idxmin())
 
 
@@ -577,13 +593,16 @@ def _trace_figure(
     estimator,
     title,
     inset,
+    selection=None,
 ) -> Figure:
     chains = _split_by_chain(traces, source, model)
-    fig = _new_figure(3.4 * len(chains) + 0.4, 5.0)
+    # One column per chain; a single chain gets the width its legend and title need.
+    fig = _new_figure(max(3.4 * len(chains) + 0.4, 6.4), 5.0)
     letters = iter("ABCDEFGHIJKLMNOPQRSTUVWXYZ")
     with mpl.rc_context(STYLE):
         axes = fig.subplots(2, len(chains), squeeze=False, sharex="col")
         for column, (n, table) in enumerate(chains.items()):
+            kept = _kept_shots(selection, table)
             amplitude = _pick_amplitude(
                 table,
                 pulses,
@@ -592,14 +611,15 @@ def _trace_figure(
                 estimator,
                 representative_force_N,
                 representative_index,
+                None if kept is None else _kept_amplitudes(table, kept),
             )
             beads = sensor_beads(table)
             s1, s2 = beads[0], beads[-1]
             shots = table[table["amplitude"] == amplitude]
             if shots.empty:
                 raise ValueError(f"N = {n}: no shot of amplitude index {amplitude}")
-            collision = _first_shot(shots, "collision")
-            reference = _first_shot(shots, "reference")
+            collision = _first_shot(shots, "collision", kept)
+            reference = _first_shot(shots, "reference", kept)
             for row, (sensor, bead) in enumerate((("S1", s1), ("S2", s2))):
                 ax = axes[row, column]
                 times = _draw_sensor(
@@ -619,7 +639,9 @@ def _trace_figure(
                 ax.set_title(heading, loc="left")
                 ax.set_ylabel("force (N)")
                 if row == 1:
-                    ax.set_xlabel("time since launch (µs)")
+                    ax.set_xlabel(
+                        "time since launch (µs)" if source == "simulation" else "time (µs)"
+                    )
         handles = [
             Line2D([], [], color=LSTW_COLOR, ls="-", label="LSTW (collision shot)"),
             Line2D([], [], color=RSTW_COLOR, ls="--", label="RSTW (collision shot)"),
@@ -645,12 +667,40 @@ def _trace_figure(
             )
         fig.legend(handles=handles, loc="outside lower center", ncol=2, frameon=False)
         model_name = next(iter(chains.values()))["model"].iloc[0]
-        fig.suptitle(f"{title}, {model_name} model")
+        if source == "simulation":
+            fig.suptitle(f"{title}, {model_name} model")
+        else:
+            named = str(model_name) in title
+            fig.suptitle(title if named else f"{title} (series {model_name})")
     return fig
 
 
-def _first_shot(shots, kind):
+def _kept_shots(selection, table) -> set | None:
+    """Shots (collision and reference) of ``table``'s chain that the acceptance protocol
+    kept; None without a selection."""
+    if selection is None or not len(selection):
+        return None
+    meta = table.iloc[0]
+    rows = selection[
+        (selection["model"] == meta["model"])
+        & (selection["N"].astype(str) == str(meta["N"]))
+        & _as_bool(selection["kept"])
+    ]
+    if "source" in selection.columns:
+        rows = rows[rows["source"] == meta["source"]]
+    return set(rows["shot"])
+
+
+def _kept_amplitudes(table, kept) -> set:
+    """Amplitude indices with at least one kept collision shot."""
+    collisions = table[(table["kind"] == "collision") & table["shot"].isin(kept)]
+    return set(collisions["amplitude"])
+
+
+def _first_shot(shots, kind, kept=None):
     rows = shots[shots["kind"] == kind]
+    if kept is not None and rows["shot"].isin(kept).any():
+        rows = rows[rows["shot"].isin(kept)]
     if rows.empty:
         return None
     return rows[rows["shot"] == rows["shot"].min()]
@@ -696,6 +746,41 @@ def _draw_sensor(ax, collision, reference, sensor, bead, s2, pulses, ssw, estima
     return times
 
 
+#: Inset of the trace figures, axes fraction: width, height, and bottom edge.
+INSET_WIDTH, INSET_HEIGHT, INSET_BOTTOM = 0.42, 0.52, 0.38
+
+
+def _inset_bounds(ax) -> list[float]:
+    """Where the SSW inset goes: upper right, else upper left, whichever the traces
+    drawn so far stay below; if neither, the y axis is raised so that they stay below
+    the inset on the right (short records, where the two pulses fill the width)."""
+    x_lo, x_hi = ax.get_xlim()
+    y_lo, y_hi = ax.get_ylim()
+    lines = [
+        (np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float))
+        for line in ax.get_lines()
+    ]
+    # Leave a small gap between the traces and the inset's lower edge.
+    clear = INSET_BOTTOM - 0.04
+    for left in (1.0 - INSET_WIDTH - 0.02, 0.02):
+        start = x_lo + left * (x_hi - x_lo)
+        stop = start + INSET_WIDTH * (x_hi - x_lo)
+        highest = max(
+            (
+                float(np.max(y[(x >= start) & (x <= stop)]))
+                for x, y in lines
+                if np.any((x >= start) & (x <= stop))
+            ),
+            default=-np.inf,
+        )
+        if highest <= y_lo + clear * (y_hi - y_lo):
+            return [left, INSET_BOTTOM, INSET_WIDTH, INSET_HEIGHT]
+    highest = max((float(np.max(y)) for _, y in lines if len(y)), default=y_hi)
+    ax.set_ylim(y_lo, y_lo + (highest - y_lo) / clear)
+    left = 1.0 - INSET_WIDTH - 0.02
+    return [left, INSET_BOTTOM, INSET_WIDTH, INSET_HEIGHT]
+
+
 def _draw_ssw_inset(ax, time, force, split, times, meta, sensor, ssw, style, template):
     """Zoom on the crossed pulse's trailing edge, where the secondary solitary wave (SSW)
     rides at the paper's sensor positions: the crossed pulse, the reference pulse
@@ -723,7 +808,7 @@ def _draw_ssw_inset(ax, time, force, split, times, meta, sensor, ssw, style, tem
             marker = (float(rows["ssw_time_us"].iloc[0]), float(rows["ssw_N"].iloc[0]))
     start, stop = t_cross - 0.6 * tau, t_cross + 3.5 * tau
     top = min(f_cross, max(0.12 * f_cross, 2.5 * marker[1] if marker else 0.0))
-    box = ax.inset_axes([0.56, 0.38, 0.42, 0.52])
+    box = ax.inset_axes(_inset_bounds(ax))
     window = (time >= start) & (time <= stop)
     if template is not None:
         ref_time, ref_force, fitted = template
@@ -802,8 +887,14 @@ def fig4_delay_vs_force(
     """
     own = ax is None
     fig, ax = _axes(ax, 6.4, 5.4)
-    rows = delays[(delays["estimator"] == estimator) & _as_bool(delays["ok"])].copy()
-    rows["abs_delay_us"] = rows["delay_us"].abs()
+    rows = delays[delays["estimator"] == estimator].copy()
+    rows["abs_delay_us"] = pd.to_numeric(rows["delay_us"], errors="coerce").abs()
+    rows = usable_rows(rows, ["F_m_N", "abs_delay_us"], f"Fig. 4 ({estimator})", positive=True)
+    per_chain = {}
+    if fits is not None and len(fits):
+        for fit in fits[(fits["estimator"] == estimator) & ~_is_pooled(fits["N"])].itertuples():
+            if fit.source == "experiment" and np.isfinite(fit.C_us_N16):
+                per_chain[(fit.model, int(fit.N))] = (fit.C_us_N16, fit.C_stderr_us_N16)
     models = list(dict.fromkeys(rows.loc[rows["source"] == "simulation", "model"]))
     colors = model_colors(models)
     all_n = sorted({int(n) for n in rows["N"]})
@@ -828,8 +919,14 @@ def fig4_delay_vs_force(
                 max(force_range[1], mean["F_m_N"].max()),
             ]
         experiment = rows[rows["source"] == "experiment"]
-        for n, group in experiment.groupby("N", sort=True):
+        several = experiment["model"].nunique() > 1
+        for (model, n), group in experiment.groupby(["model", "N"], sort=True):
             marker = chain_marker(int(n), all_n)
+            label = f"{experiment_label}, {model}" if several else experiment_label
+            label += f", N = {int(n)}"
+            if (model, int(n)) in per_chain:
+                c, err = per_chain[(model, int(n))]
+                label += f" (own fit C = {c:.1f} ± {err:.1f})"
             ax.plot(
                 group["F_m_N"],
                 group["abs_delay_us"],
@@ -840,7 +937,7 @@ def fig4_delay_vs_force(
                 color="black",
                 ms=5,
                 mew=0.9,
-                label=f"{experiment_label}, N = {int(n)}",
+                label=label,
             )
             force_range = [
                 min(force_range[0], group["F_m_N"].min()),
@@ -855,7 +952,7 @@ def fig4_delay_vs_force(
                 if not np.isfinite(fit.C_us_N16):
                     continue
                 who = (
-                    f"{experiment_label} fit"
+                    f"fit to {experiment_label}, N pooled"
                     if fit.source == "experiment"
                     else f"fit to simulation, {fit.model}"
                 )
@@ -937,8 +1034,7 @@ def fig5_ssw_vs_force(
     """
     own = ax is None
     fig, ax = _axes(ax, 6.4, 5.0)
-    ssw = _main_method(ssw)
-    rows = ssw[_as_bool(ssw["ok"]) & (ssw["ssw_N"] > 0) & (ssw["F_m_N"] > 0)]
+    rows = usable_rows(_main_method(ssw), ["F_m_N", "ssw_N"], "Fig. 5 SSW rows", positive=True)
     models = list(dict.fromkeys(rows.loc[rows["source"] == "simulation", "model"]))
     colors = model_colors(models)
     all_n = sorted({int(n) for n in rows["N"]})
@@ -1012,7 +1108,8 @@ def fig_parity_ssw_vs_N(
     own = ax is None
     fig, ax = _axes(ax, 6.0, 4.4)
     ssw_fits = _main_method(ssw_fits)
-    rows = ssw_fits[~_is_pooled(ssw_fits["N"])].copy()
+    rows = ssw_fits[~_is_pooled(ssw_fits["N"])].assign(ok=True)
+    rows = usable_rows(rows, ["slope", "slope_stderr"], "parity figure: SSW fits").copy()
     rows["N"] = rows["N"].astype(int)
     models = list(dict.fromkeys(rows.loc[rows["source"] == "simulation", "model"]))
     colors = model_colors(models)

@@ -10,6 +10,7 @@ writes both atomically with sorted keys and fixed float formatting.
 from __future__ import annotations
 
 import json
+import logging
 import math
 import os
 import tempfile
@@ -35,6 +36,125 @@ PAPER_ENERGY_DRIFT = 1e-9
 
 #: Significant digits of floats in summary.json.
 JSON_DIGITS = 10
+
+log = logging.getLogger(__name__)
+
+
+def _ok(table: pd.DataFrame) -> pd.Series:
+    """The ``ok`` column as booleans (True/False or their text); missing or NaN is False."""
+    if "ok" not in table.columns:
+        return pd.Series(True, index=table.index)
+    column = table["ok"]
+    if column.dtype == bool:
+        return column
+    return column.astype(str).str.strip().str.lower().isin(("true", "1", "1.0"))
+
+
+def usable_rows(
+    table: pd.DataFrame, columns: Iterable[str], what: str = "rows", *, positive: bool = False
+) -> pd.DataFrame:
+    """The rows fit to draw or fit: ``ok`` True and finite (and > 0 if ``positive``) in
+    ``columns``; how many were left out, and why, goes to the log (INFO).
+
+    A flagged row (``ok`` False, with its ``reason``) or a NaN never passes quietly into
+    a figure or a fit.
+
+    Parameters
+    ----------
+    table : DataFrame
+        A results table with an ``ok`` column (``delays.csv``, ``ssw.csv``, ...).
+    columns : iterable of str
+        Value columns that must be finite.
+    what : str
+        Name of the rows in the log message.
+    positive : bool
+        Also require values > 0 (for a log axis).
+    """
+    columns = list(columns)
+    ok = _ok(table)
+    values = table[columns].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
+    finite = np.isfinite(values).all(axis=1) if columns else np.ones(len(table), bool)
+    good = ok.to_numpy() & finite
+    nonpositive = np.zeros(len(table), bool)
+    if positive and columns:
+        nonpositive = good & ~(values > 0).all(axis=1)
+        good &= ~nonpositive
+    left_out = len(table) - int(good.sum())
+    if left_out:
+        log.info(
+            "%s: %d of %d left out (%d flagged ok = False, %d ok but NaN/inf in %s%s)",
+            what,
+            left_out,
+            len(table),
+            int((~ok).sum()),
+            int((ok.to_numpy() & ~finite).sum()),
+            columns,
+            f", {int(nonpositive.sum())} <= 0 on a log axis" if positive else "",
+        )
+    return table[good]
+
+
+def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict:
+    """Rows and flagged rows of a results table, per source.
+
+    Parameters
+    ----------
+    table : DataFrame or None
+        A table with ``source`` and ``ok`` columns.
+    columns : iterable of str
+        Value columns: an ``ok`` row with a NaN there counts as ``nan``.
+
+    Returns
+    -------
+    dict
+        ``{source: {"rows": n, "flagged": n_ok_false, "nan": n_ok_but_nan}}``.
+    """
+    if table is None or not len(table):
+        return {}
+    columns = list(columns)
+    ok = _ok(table)
+    counts = {}
+    for source, group in table.groupby("source", sort=True):
+        good = ok.loc[group.index]
+        values = group[columns].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
+        nan = good.to_numpy() & ~np.isfinite(values).all(axis=1) if columns else 0
+        counts[str(source)] = {
+            "rows": len(group),
+            "flagged": int((~good).sum()),
+            "nan": int(np.sum(nan)),
+        }
+    return counts
+
+
+def selection_counts(selection: pd.DataFrame | None) -> list[dict]:
+    """Kept and rejected shots of the acceptance protocol per series, chain and kind.
+
+    Parameters
+    ----------
+    selection : DataFrame or None
+        ``experiment/selection.csv`` (:func:`chain.protocol.select_shots`).
+
+    Returns
+    -------
+    list of dict
+        ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
+    """
+    if selection is None or not len(selection):
+        return []
+    kept = _ok(selection.rename(columns={"kept": "ok"})[["ok"]])
+    rows = []
+    for (model, n, kind), group in selection.groupby(["model", "N", "kind"], sort=True):
+        k = int(kept.loc[group.index].sum())
+        rows.append(
+            {
+                "model": str(model),
+                "N": int(n),
+                "kind": str(kind),
+                "kept": k,
+                "rejected": len(group) - k,
+            }
+        )
+    return rows
 
 
 def run_constants(material: str, radius_m: float) -> dict[str, float]:
@@ -109,6 +229,11 @@ def build_summary(
     conservative_models: Iterable[str] = ("elastic",),
     main_estimator: str = "fit_full",
     experiment_label: str = "experiment",
+    pulses: pd.DataFrame | None = None,
+    delays: pd.DataFrame | None = None,
+    ssw: pd.DataFrame | None = None,
+    selection: pd.DataFrame | None = None,
+    tolerance: float | None = None,
 ) -> dict:
     """The contents of ``summary.json``.
 
@@ -133,6 +258,12 @@ def build_summary(
     experiment_label : str
         Name of ``source == "experiment"`` rows in summary.md ("virtual experiment
         (model)" for the model of the apparatus).
+    pulses, delays, ssw : DataFrame, optional
+        ``pulses.csv``, ``delays.csv``, ``ssw.csv``: their flagged rows are counted.
+    selection : DataFrame, optional
+        ``experiment/selection.csv``: kept and rejected shots are counted.
+    tolerance : float, optional
+        The acceptance tolerance that made ``selection`` (fraction).
 
     Returns
     -------
@@ -141,7 +272,10 @@ def build_summary(
         ``conservative_models``, ``constants``,
         ``paper``, ``max_energy_drift`` (largest relative drift of the conservative
         runs, None without any), ``energy_drift_by_model``, ``delay_fits`` and
-        ``ssw_fits`` (the rows of the tables).
+        ``ssw_fits`` (the rows of the tables), ``flagged`` (per table and source:
+        ``rows``, ``flagged`` = ok False, ``nan`` = ok but a NaN value; ssw counts the
+        ``residual`` rows, the ones fitted and drawn), ``selection`` (kept/rejected
+        shots per series, N and kind) and ``experiment_tolerance``.
     """
     conservative = set(conservative_models)
     drift_by_model = {}
@@ -167,6 +301,13 @@ def build_summary(
             "energy_drift_by_model": drift_by_model,
             "delay_fits": _records(delay_fits),
             "ssw_fits": _records(ssw_fits),
+            "flagged": {
+                "pulses": flag_counts(pulses, ["F_m_N", "T_s"]),
+                "delays": flag_counts(delays, ["F_m_N", "delay_us"]),
+                "ssw": flag_counts(_residual_rows(ssw), ["F_m_N", "ssw_N"]),
+            },
+            "selection": selection_counts(selection),
+            "experiment_tolerance": tolerance,
         }
     )
 
@@ -194,8 +335,13 @@ def _pm(value, error, digits=2) -> str:
 def _who(row: Mapping, experiment_label: str = "experiment") -> str:
     n = row["N"]
     chains = "all N pooled" if n == "pooled" else f"N = {n}"
-    source = experiment_label if row["source"] == "experiment" else row["source"]
-    return f"{source}, {row['model']}, {chains}"
+    if row["source"] == "experiment":
+        # The label may name the series already ("virtual experiment (model)" for
+        # "virtual", "measured (lab2011)" for "lab2011").
+        if str(row["model"]) in experiment_label:
+            return f"{experiment_label}, {chains}"
+        return f"{experiment_label}, {row['model']}, {chains}"
+    return f"{row['source']}, {row['model']}, {chains}"
 
 
 def summary_markdown(summary: Mapping) -> str:
@@ -243,9 +389,14 @@ def summary_markdown(summary: Mapping) -> str:
         (
             "C_exp, experiment fit (µs N^1/6)",
             f"{c_exp:.1f} ± {c_exp_err:.1f}",
-            _experiment_c(summary, main),
-            "the paper's fit of its measurements; this run has "
-            + ("experiment rows (see below)" if _has_experiment(summary) else "no experiment"),
+            _experiment_c(summary, main, label),
+            "the paper's fit of its measurements, N = 25 and 26 pooled; "
+            + (
+                f"this run: its experiment series ({label}), chains pooled"
+                + ("; a model of the apparatus, not data" if "virtual" in label else "")
+                if _has_experiment(summary)
+                else "this run has no experiment"
+            ),
         ),
     ]
     fits = sorted(
@@ -316,6 +467,8 @@ def summary_markdown(summary: Mapping) -> str:
                 note,
             )
         )
+    rows += _selection_rows(summary, label)
+    rows += _flagged_rows(summary, label)
     drift = summary.get("max_energy_drift")
     rows.append(
         (
@@ -389,11 +542,74 @@ def _dissipation_rows(summary, main) -> list[tuple[str, str, str, str]]:
     return rows
 
 
+def _residual_rows(ssw: pd.DataFrame | None) -> pd.DataFrame | None:
+    """The SSW rows that are fitted and drawn (method ``residual``)."""
+    if ssw is None or "method" not in ssw.columns:
+        return ssw
+    return ssw[ssw["method"] == "residual"]
+
+
+def _selection_rows(summary, label) -> list[tuple[str, str, str, str]]:
+    """One row per series: kept and rejected shots of the acceptance protocol."""
+    counts = summary.get("selection") or []
+    tolerance = summary.get("experiment_tolerance")
+    limit = "the tolerance" if tolerance is None else f"{100 * tolerance:g} %"
+    rows = []
+    for model in dict.fromkeys(c["model"] for c in counts):
+        parts = []
+        for n in sorted({c["N"] for c in counts if c["model"] == model}):
+            kinds = {c["kind"]: c for c in counts if c["model"] == model and c["N"] == n}
+            text = []
+            for kind, word in (("collision", "collisions"), ("reference", "references")):
+                if kind in kinds:
+                    c = kinds[kind]
+                    text.append(f"{c['kept']} of {c['kept'] + c['rejected']} {word} kept")
+            parts.append(f"N = {n}: " + ", ".join(text))
+        rows.append(
+            (
+                f"acceptance protocol, {label if model in label else f'{label}, {model}'}",
+                "collisions kept if the incident amplitudes differ by ≤ 5 % (Sec. IV); "
+                "no counts printed",
+                "; ".join(parts),
+                f"|F_L − F_R| / mean ≤ {limit}; every shot and the reason in "
+                "experiment/selection.csv; rejected collisions are left out of Δ and SSW",
+            )
+        )
+    return rows
+
+
+def _flagged_rows(summary, label) -> list[tuple[str, str, str, str]]:
+    """How many table rows were flagged (ok False) or NaN, and so left out."""
+    flagged = summary.get("flagged") or {}
+    parts = []
+    for table, by_source in flagged.items():
+        counts = []
+        for source, c in sorted(by_source.items(), key=lambda item: item[0] != "simulation"):
+            who = label if source == "experiment" else source
+            text = f"{c['flagged']} of {c['rows']} ({who})"
+            if c.get("nan"):
+                text += f" + {c['nan']} ok but NaN"
+            counts.append(text)
+        if counts:
+            parts.append(f"{table}: " + ", ".join(counts))
+    if not parts:
+        return []
+    return [
+        (
+            "flagged rows (ok = False), left out of fits and figures",
+            "—",
+            "; ".join(parts),
+            "the reason of each is in the table's reason column; ssw counts the residual "
+            "rows (the fitted ones)",
+        )
+    ]
+
+
 def _has_experiment(summary) -> bool:
     return any(r["source"] == "experiment" for r in summary["delay_fits"])
 
 
-def _experiment_c(summary, main) -> str:
+def _experiment_c(summary, main, label="experiment") -> str:
     rows = [
         r
         for r in summary["delay_fits"]
@@ -402,7 +618,9 @@ def _experiment_c(summary, main) -> str:
     if not rows:
         return "—"
     return "; ".join(
-        f"{r['model']}: {_pm(r.get('C_us_N16'), r.get('C_stderr_us_N16'), 1)}" for r in rows
+        f"{label if r['model'] in label else r['model']}: "
+        f"{_pm(r.get('C_us_N16'), r.get('C_stderr_us_N16'), 1)}"
+        for r in rows
     )
 
 
