@@ -1,7 +1,9 @@
 """The Snakemake pipeline end to end on a tiny config (tests/configs/tiny.yaml) in a
-temporary directory: every contract file appears with its columns, a second run has
-nothing to do, editing a library file reruns exactly what depends on it, and the
-workflow is lint- and format-clean.
+temporary directory: every contract file appears with its columns, the virtual
+experiment runs through the acceptance protocol into Fig. 2 and the tables, a second run
+has nothing to do, editing a library file reruns exactly what depends on it, and the
+workflow is lint- and format-clean. A second tiny run (tests/configs/tiny_measured.yaml)
+reads the committed dataset tests/data/virtual_small as a lab's measured dataset.
 
 The run uses a copy of the library (``PYTHONPATH``) so that the test can touch its
 source files without touching the checkout's.
@@ -22,6 +24,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "tests" / "configs" / "tiny.yaml"
+TINY_MEASURED = ROOT / "tests" / "configs" / "tiny_measured.yaml"
+DATASET = Path("tests") / "data" / "virtual_small"
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 pytestmark = pytest.mark.workflow
@@ -46,11 +50,16 @@ TABLE_COLUMNS = {
 
 FIGURES = [
     "fig1_setup",
+    "fig2_experiment_traces",
     "fig3_simulation_traces",
     "fig4_delay_vs_force",
     "fig5_ssw_vs_force",
     "fig_parity_ssw_vs_N",
 ]
+
+
+def env() -> dict:
+    return dict(os.environ)
 
 
 def run(args, work: Path, env: dict, timeout=600) -> subprocess.CompletedProcess:
@@ -98,12 +107,40 @@ def test_contract_files_and_columns(tiny):
         missing = [c for c in columns if c not in table.columns]
         assert not missing, f"{name}.csv lacks {missing}"
         assert len(table) > 0, f"{name}.csv is empty"
-        assert set(table["source"]) == {"simulation"}
-        assert set(table["model"]) == {"elastic", "viscoelastic"}
+        assert set(table["source"]) == {"simulation", "experiment"}
+        assert set(table["model"]) == {"elastic", "viscoelastic", "virtual"}
     for name in FIGURES:
         assert (out / "figures" / f"{name}.pdf").read_bytes().startswith(b"%PDF"), name
         assert (out / "figures" / f"{name}.png").read_bytes().startswith(b"\x89PNG"), name
-    assert not (out / "figures" / "fig2_experiment_traces.png").exists()
+
+
+def test_virtual_experiment_and_selection(tiny):
+    _, out, _, _ = tiny
+    for n in (16, 17):
+        raw = out / "experiment" / "raw" / f"N{n}"
+        metadata = (raw / "metadata.yaml").read_text()
+        assert "virtual experiment (model)" in metadata
+        assert len(list(raw.glob("shot_*.csv"))) == 3 * (2 + 1)  # amplitudes x shots
+        traces = pd.read_csv(out / "experiment" / f"virtual_N{n}_traces.csv")
+        assert set(traces["source"]) == {"experiment"} and set(traces["N"]) == {n}
+        assert (out / "logs" / "experiment" / f"virtual_N{n}.log").exists()
+        assert (out / "benchmarks" / "experiment" / f"virtual_N{n}_traces.tsv").exists()
+    selection = pd.read_csv(out / "experiment" / "selection.csv")
+    assert list(selection.columns) == [
+        "source", "model", "N", "shot", "kind", "amplitude", "F_left_N", "F_right_N",
+        "mismatch", "kept", "reason",
+    ]  # fmt: skip
+    assert len(selection) == 2 * 9 and selection["reason"].str.len().gt(0).all()
+    rejected = selection[~selection["kept"]]
+    kept = selection[selection["kept"] & (selection["kind"] == "collision")]
+    assert (kept["mismatch"] <= 0.05).all() and (rejected["kind"] == "collision").all()
+    # Rejected collisions are left out of the delays and the SSW.
+    delays = pd.read_csv(out / "tables" / "delays.csv")
+    experiment = delays[delays["source"] == "experiment"]
+    assert not set(zip(rejected["N"], rejected["shot"])) & set(
+        zip(experiment["N"], experiment["shot"])
+    )
+    assert set(zip(experiment["N"], experiment["shot"])) == set(zip(kept["N"], kept["shot"]))
 
 
 def test_fits_cover_every_model_and_chain(tiny):
@@ -114,10 +151,12 @@ def test_fits_cover_every_model_and_chain(tiny):
         for n in ("16", "17", "pooled"):
             for estimator in ("fit_full", "peak", "fit_rise"):
                 assert (model, n, estimator) in keys
+    for n in ("16", "17", "pooled"):
+        assert ("virtual", n, "fit_full") in keys
     ok = fits[fits["estimator"] == "fit_full"]
     assert ok["C_us_N16"].between(20, 80).all(), ok
     ssw_fits = pd.read_csv(out / "tables" / "ssw_fits.csv")
-    assert len(ssw_fits) == 4
+    assert len(ssw_fits) == 4 + 2
 
 
 def test_simulation_outputs_logs_and_benchmarks(tiny):
@@ -154,9 +193,22 @@ def test_summary(tiny):
         "C_bal_us_N16": 49.74,
     }
     assert 0 < summary["max_energy_drift"] < 1e-8
-    assert len(summary["delay_fits"]) == 2 * 3 * 3
-    assert len(summary["ssw_fits"]) == 4
-    assert "| quantity | paper | this run | note |" in (out / "summary.md").read_text()
+    assert len(summary["delay_fits"]) == (2 + 1) * 3 * 3  # models + experiment, N x 3
+    assert len(summary["ssw_fits"]) == 4 + 2
+    assert summary["experiment_label"] == "virtual experiment (model)"
+    selection = pd.read_csv(out / "experiment" / "selection.csv")
+    counts = {(c["N"], c["kind"]): c for c in summary["selection"]}
+    for n in (16, 17):
+        chosen = selection[(selection["N"] == n) & (selection["kind"] == "collision")]
+        assert counts[(n, "collision")]["kept"] == chosen["kept"].sum()
+        assert counts[(n, "collision")]["rejected"] == (~chosen["kept"]).sum()
+    assert set(summary["flagged"]) == {"pulses", "delays", "ssw"}
+    assert summary["flagged"]["delays"]["experiment"]["rows"] > 0
+    text = (out / "summary.md").read_text()
+    assert "| quantity | paper | this run | note |" in text
+    assert "| C_exp, experiment fit (µs N^1/6) | 45.9 ± 0.5 | virtual experiment (model): " in text
+    assert "acceptance protocol, virtual experiment (model) |" in text
+    assert "SSW slope, virtual experiment (model), N = 17" in text
 
 
 def test_second_run_has_nothing_to_do(tiny):
@@ -167,10 +219,18 @@ def test_second_run_has_nothing_to_do(tiny):
 @pytest.mark.parametrize(
     ("module", "expected", "untouched"),
     [
-        ("figures", set(FIGURES) | {"all"}, {"simulate", "pulses", "summary"}),
-        ("ssw", {"ssw", "ssw_fits", "fig3_simulation_traces", "fig5_ssw_vs_force", "summary"},
-         {"simulate", "pulses", "delays"}),
-        ("model", {"simulate", "pulses", "delays", "ssw", "summary"}, set()),
+        ("figures", set(FIGURES) | {"all"},
+         {"simulate", "virtual_experiment", "pulses", "selection", "summary"}),
+        ("ssw", {"ssw", "ssw_fits", "fig2_experiment_traces", "fig3_simulation_traces",
+                 "fig5_ssw_vs_force", "summary"},
+         {"simulate", "virtual_experiment", "experiment_traces", "pulses", "selection",
+          "delays"}),
+        ("protocol", {"selection", "delays", "ssw", "fig2_experiment_traces", "summary"},
+         {"simulate", "virtual_experiment", "experiment_traces", "pulses"}),
+        ("experiment", {"virtual_experiment", "experiment_traces", "pulses", "selection"},
+         {"simulate", "fig1_setup"}),
+        ("model", {"simulate", "virtual_experiment", "pulses", "delays", "ssw", "summary"},
+         set()),
     ],
 )  # fmt: skip
 def test_editing_the_library_reruns_what_depends_on_it(tiny, module, expected, untouched):
@@ -187,7 +247,56 @@ def test_editing_the_library_reruns_what_depends_on_it(tiny, module, expected, u
     assert expected <= set(jobs), jobs
     assert not untouched & set(jobs), jobs
     if module == "model":
-        assert jobs["simulate"] == 4
+        assert jobs["simulate"] == 4 and jobs["virtual_experiment"] == 2
+    if module == "experiment":
+        assert jobs["virtual_experiment"] == 2
+
+
+@pytest.fixture(scope="module")
+def measured(tmp_path_factory):
+    """The tiny run on the committed dataset, read as a lab's measured dataset."""
+    work = tmp_path_factory.mktemp("measured") / "work"
+    work.mkdir()
+    shutil.copy(ROOT / "config.yaml", work / "config.yaml")
+    shutil.copytree(ROOT / DATASET, work / DATASET)
+    out = work / "results" / "tiny_measured"
+    # The experiment's part of the pipeline: tables, Fig. 2 and the summary (Fig. 1, 3-5
+    # are the tiny run's business).
+    targets = [  # relative to the working directory, as Snakemake names its outputs
+        "results/tiny_measured/summary.json",
+        "results/tiny_measured/figures/fig2_experiment_traces.png",
+    ]
+    result = run([*targets, "--cores", "2", "--configfile", str(TINY_MEASURED)], work, env())
+    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    return out
+
+
+def test_measured_dataset_runs_the_same_analysis(measured):
+    out = measured
+    assert not (out / "experiment" / "raw").exists(), "no virtual experiment for measured data"
+    traces = pd.read_csv(out / "experiment" / "virtual_small_N25_traces.csv")
+    assert set(traces["model"]) == {"virtual_small"} and traces["shot"].nunique() == 6
+    selection = pd.read_csv(out / "experiment" / "selection.csv")
+    assert len(selection) == 6 and set(selection["model"]) == {"virtual_small"}
+    for name, columns in TABLE_COLUMNS.items():
+        table = pd.read_csv(out / "tables" / f"{name}.csv")
+        assert not [c for c in columns if c not in table.columns], name
+        assert set(table["source"]) == {"simulation", "experiment"}, name
+    fits = pd.read_csv(out / "tables" / "delay_fits.csv")
+    pooled = fits[
+        (fits["source"] == "experiment")
+        & (fits["N"] == "pooled")
+        & (fits["estimator"] == "fit_full")
+    ]
+    assert pooled["C_us_N16"].between(20, 80).all() and (pooled["n_points"] >= 4).all()
+    assert (out / "figures" / "fig2_experiment_traces.png").read_bytes().startswith(b"\x89PNG")
+    summary = json.loads((out / "summary.json").read_text())
+    # Written by the virtual experiment: labelled as a model even when read as "measured".
+    assert summary["experiment_label"] == "virtual experiment (model): virtual_small"
+    assert {(c["kind"], c["kept"] + c["rejected"]) for c in summary["selection"]} == {
+        ("collision", 4),
+        ("reference", 2),
+    }
 
 
 def test_lint_clean():

@@ -44,7 +44,7 @@ rule delays:
 rule delay_fits:
     input:
         delays=f"{TABLES}/delays.csv",
-        lib=LIB_DELAYS,
+        lib=LIB_DELAYS + LIB_SUMMARY,
     output:
         report(
             f"{TABLES}/delay_fits.csv",
@@ -84,7 +84,7 @@ rule ssw:
 rule ssw_fits:
     input:
         ssw=f"{TABLES}/ssw.csv",
-        lib=LIB_SSW,
+        lib=LIB_SSW + LIB_SUMMARY,
     output:
         report(
             f"{TABLES}/ssw_fits.csv",

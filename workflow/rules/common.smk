@@ -6,7 +6,13 @@ from pathlib import Path
 
 import numpy as np
 
-from chain.config_checks import check_config
+from chain.config_checks import (
+    VIRTUAL_SERIES,
+    check_config,
+    experiment_parts,
+    virtual_experiment_settings,
+)
+from chain.config_checks import experiment_label as experiment_label_of
 
 check_config(config)
 
@@ -58,6 +64,9 @@ LIB_DELAYS = LIB_PULSES + lib("regression", "delays")
 LIB_SSW = LIB_DELAYS + lib("ssw")
 LIB_SUMMARY = lib("materials", "theory", "summary")
 LIB_FIGURES = LIB_SUMMARY + lib("traces", "figures")
+LIB_MEASURED = lib("materials", "acquisition", "traces", "measured")
+LIB_EXPERIMENT = LIB_SIMULATE + LIB_MEASURED + lib("experiment")
+LIB_SELECTION = lib("materials", "protocol")
 
 
 # ---- trace sources -------------------------------------------------------------
@@ -65,20 +74,18 @@ LIB_FIGURES = LIB_SUMMARY + lib("traces", "figures")
 # model and chain; the analysis reads them all.
 SIMULATION_PARTS = [("simulation", model, n) for model in MODELS for n in CHAINS]
 
-# Experiment traces (virtual or measured, issue 5) plug in here, from a rule file
-# workflow/rules/experiment.smk included in the Snakefile (anywhere after common.smk:
-# everything below is read through functions, at DAG time):
-#   * rules writing trace_file("experiment", <dataset>, N) (chain.traces format) for
-#     each chain, and append ("experiment", <dataset>, N) to EXPERIMENT_PARTS;
-#   * optionally a rule writing chain.protocol.select_shots' table, its path appended
-#     to SELECTION (the delay and SSW tables then drop rejected collision shots);
-#   * EXPERIMENT_LABEL = "virtual experiment (model)" when the traces come from the
-#     model of the apparatus (figures and summary.md name the series with it);
-#   * its config keys added to workflow/schemas/config.schema.yaml.
-# Then Fig. 2 joins rule all, and Fig. 4/5 and the summary show the experiment series.
-EXPERIMENT_PARTS = []
-SELECTION = []
-EXPERIMENT_LABEL = "experiment"
+# Experiment traces (issue 5; rules in experiment.smk): one part per chain of the
+# virtual experiment (its datasets are written to experiment/raw/N<N>/), or one per
+# measured dataset folder of experiment.datasets (N and sensors from its metadata.yaml,
+# read here: a bad dataset stops the run before any job, naming the key). Their
+# selection table (the 5 % amplitude match) feeds the delay and SSW tables; Fig. 2 joins
+# rule all; figures and summary name the series with EXPERIMENT_LABEL ("virtual
+# experiment (model)" for the model of the apparatus, "measured (<name>)" for data).
+EXPERIMENT = {(part.name, part.n_beads): part for part in experiment_parts(config)}
+EXPERIMENT_PARTS = [("experiment", name, n) for name, n in EXPERIMENT]
+SELECTION = [f"{OUT}/experiment/selection.csv"] if EXPERIMENT else []
+EXPERIMENT_LABEL = experiment_label_of(list(EXPERIMENT.values()))
+VIRTUAL_NAME = config["experiment"]["name"] or VIRTUAL_SERIES
 
 
 def selection_files(wildcards):
@@ -87,6 +94,53 @@ def selection_files(wildcards):
 
 def experiment_label(wildcards):
     return EXPERIMENT_LABEL
+
+
+def experiment_part(wildcards):
+    key = (wildcards.dataset, int(wildcards.N))
+    if key not in EXPERIMENT:
+        raise ValueError(
+            f"no experiment series {key[0]!r} with N = {key[1]} in this config; "
+            f"configured: {sorted(EXPERIMENT)}"
+        )
+    return EXPERIMENT[key]
+
+
+def raw_dataset(n):
+    """Folder of the virtual experiment's dataset of the chain of n beads."""
+    return f"{OUT}/experiment/raw/N{n}"
+
+
+def experiment_dataset_files(wildcards):
+    """What loading a dataset depends on: the virtual experiment's folder, or the
+    measured dataset's metadata.yaml and shot files (editing one reloads it)."""
+    part = experiment_part(wildcards)
+    if part.folder is None:
+        return [raw_dataset(part.n_beads)]
+    return list(part.files)
+
+
+def experiment_dataset_folder(wildcards):
+    part = experiment_part(wildcards)
+    return raw_dataset(part.n_beads) if part.folder is None else part.folder
+
+
+def virtual_settings(wildcards):
+    """chain.experiment.VirtualExperiment fields of one chain (plain values)."""
+    n = int(wildcards.N)
+    return virtual_experiment_settings(config, n, CHAINS[n]["sensors"])
+
+
+def experiment_trace_files(wildcards=None):
+    return [trace_file(*part) for part in EXPERIMENT_PARTS]
+
+
+def fig2_trace_files(wildcards):
+    """Experiment chains shown in Fig. 2: those in figures.traces_N when it is set
+    (all of them if it names none), else all."""
+    chosen = config["figures"]["traces_N"]
+    shown = [part for part in EXPERIMENT_PARTS if not chosen or part[2] in chosen]
+    return [trace_file(*part) for part in shown or EXPERIMENT_PARTS]
 
 
 def trace_file(source, model, n):

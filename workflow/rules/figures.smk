@@ -24,11 +24,10 @@ rule fig1_setup:
 
 rule fig2_experiment_traces:
     input:
-        traces=lambda wildcards: [
-            trace_file(*part) for part in EXPERIMENT_PARTS if part[2] in TRACES_N
-        ],
+        traces=fig2_trace_files,
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
+        selection=selection_files,
         lib=LIB_FIGURES,
     output:
         **figure_outputs("fig2_experiment_traces"),
@@ -40,8 +39,9 @@ rule fig2_experiment_traces:
         ENV
     params:
         model=None,
-        representative_force_N=config["figures"]["representative_force_N"],
-        representative_index=config["figures"]["representative_index"],
+        representative_force_N=config["figures"]["experiment_force_N"]
+        or config["figures"]["representative_force_N"],
+        representative_index=None,
         estimator=config["analysis"]["main_estimator"],
         label=experiment_label,
     script:

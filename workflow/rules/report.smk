@@ -5,6 +5,10 @@ rule summary:
     input:
         delay_fits=f"{TABLES}/delay_fits.csv",
         ssw_fits=f"{TABLES}/ssw_fits.csv",
+        pulses=f"{TABLES}/pulses.csv",
+        delays=f"{TABLES}/delays.csv",
+        ssw=f"{TABLES}/ssw.csv",
+        selection=selection_files,
         runs=runs_files(),
         lib=LIB_SUMMARY,
     output:
@@ -25,6 +29,7 @@ rule summary:
         conservative_models=CONSERVATIVE,
         estimator=config["analysis"]["main_estimator"],
         experiment_label=experiment_label,
+        tolerance=config["experiment"]["tolerance"],
     script:
         "../scripts/summary.py"
 

@@ -1,6 +1,7 @@
 """summary.json and summary.md: the run's numbers beside the paper's (chain.summary)."""
 
 import pandas as pd
+from _inputs import selection
 from _logging import start
 
 from chain.summary import build_summary, write_summary
@@ -17,6 +18,13 @@ summary = build_summary(
     conservative_models=p.conservative_models,
     main_estimator=p.estimator,
     experiment_label=p.experiment_label,
+    pulses=pd.read_csv(snakemake.input.pulses),
+    delays=pd.read_csv(snakemake.input.delays),
+    ssw=pd.read_csv(snakemake.input.ssw),
+    selection=selection(snakemake),
+    tolerance=p.tolerance if snakemake.input.get("selection") else None,
 )
 write_summary(summary, snakemake.output.json, snakemake.output.md)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
+log.info("flagged rows: %s", summary["flagged"])
+log.info("selection: %s", summary["selection"])
