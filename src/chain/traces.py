@@ -184,7 +184,9 @@ def iter_shots(table: pd.DataFrame):
 
 def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     """Write ``table`` as CSV to a temporary name beside ``path`` and rename it, so that
-    an interrupted write never leaves a partial file under the final name.
+    an interrupted write never leaves a partial file under the final name. The file
+    gets the permissions of an ordinary new file (``0o666`` less the umask), not the
+    ``0o600`` of a temporary file.
 
     Parameters
     ----------
@@ -199,7 +201,15 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     try:
         with os.fdopen(handle, "w", newline="") as stream:
             table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
+        _ordinary_permissions(temporary)
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+def _ordinary_permissions(path: str | os.PathLike) -> None:
+    """Give a temporary file (created 0600 by mkstemp) the permissions ``open`` gives."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(path, 0o666 & ~umask)
