@@ -663,12 +663,6 @@ def test_silent_sensors_give_flagged_rows_all_the_way_to_the_fits():
     assert (ssw_fits["n_points"] == 0).all() and ssw_fits["slope"].isna().all()
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="chain.pulses.estimate_baseline: on a noise-only signal the fallback estimates "
-    "the noise from the samples within QUIET_FRACTION of the excursion only, a fraction "
-    "of the true sigma, so noise peaks pass the 8-sigma threshold (~45 % of seeds)",
-)
 def test_noise_only_signals_have_no_pulse():
     """Gaussian noise alone, over many seeds, never gives a pulse (the 8-sigma threshold
     is meant to stop the largest of 10^4 samples)."""

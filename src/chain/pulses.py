@@ -166,7 +166,8 @@ def estimate_baseline(time_s, force_N) -> tuple[float, float]:
     baseline_N : float
         Median of the pre-pulse part, N.
     noise_N : float
-        Its standard deviation (1.4826 x median absolute deviation), N.
+        Its standard deviation (1.4826 x median absolute deviation), N, or the one from
+        successive differences of the whole signal if that is larger.
     """
     force = np.asarray(force_N, dtype=float)
     rough = float(np.median(force))
@@ -185,6 +186,13 @@ def estimate_baseline(time_s, force_N) -> tuple[float, float]:
                 quiet = force[np.abs(force - rough) <= QUIET_FRACTION * excursion]
     baseline = float(np.median(quiet))
     noise = 1.4826 * float(np.median(np.abs(quiet - baseline)))
+    # On a signal with no pulse the "quiet" samples are only those near the median, and
+    # their spread underestimates the noise. Successive differences of the whole signal
+    # give a second, robust estimate (pulses are smooth on the sampling scale, so they
+    # barely move the median of the differences); the larger of the two is kept.
+    if force.size > 2:
+        steps = np.diff(force)
+        noise = max(noise, 1.4826 * float(np.median(np.abs(steps - np.median(steps)))) / 2**0.5)
     return baseline, noise
 
 
