@@ -475,7 +475,7 @@ BAD_CONFIGS = {
         "holds fewer than 10 samples",
     ),
     "virtual: time step <= sampling": (
-        setter("experiment", "virtual", "time_step_s", value=2e-6),
+        setter("experiment", "virtual", "time_step_s", value=3e-6),
         key("experiment.virtual.time_step_s"),
         "allowed: <= the sampling interval, or null",
     ),

@@ -124,7 +124,11 @@ def test_virtual_experiment_and_selection(tiny):
         traces = pd.read_csv(out / "experiment" / f"virtual_N{n}_traces.csv")
         assert set(traces["source"]) == {"experiment"} and set(traces["N"]) == {n}
         assert (out / "logs" / "experiment" / f"virtual_N{n}.log").exists()
-        assert (out / "benchmarks" / "experiment" / f"virtual_N{n}_traces.tsv").exists()
+        assert (out / "benchmarks" / "experiment" / f"virtual_N{n}.tsv").exists()
+    assert (
+        "virtual_N17_traces.csv: 6 collision and 3 reference shots"
+        in (out / "logs" / "experiment" / "traces.log").read_text()
+    )
     selection = pd.read_csv(out / "experiment" / "selection.csv")
     assert list(selection.columns) == [
         "source", "model", "N", "shot", "kind", "amplitude", "F_left_N", "F_right_N",

@@ -16,6 +16,7 @@ rule pulses:
         f"{LOGS}/tables/pulses.log",
     benchmark:
         f"{BENCH}/tables/pulses.tsv"
+    priority: 2
     conda:
         ENV
     params:
@@ -35,6 +36,7 @@ rule delays:
         f"{LOGS}/tables/delays.log",
     benchmark:
         f"{BENCH}/tables/delays.tsv"
+    priority: 1
     conda:
         ENV
     script:
@@ -55,6 +57,7 @@ rule delay_fits:
         f"{LOGS}/tables/delay_fits.log",
     benchmark:
         f"{BENCH}/tables/delay_fits.tsv"
+    priority: 1
     conda:
         ENV
     script:
@@ -73,6 +76,7 @@ rule ssw:
         f"{LOGS}/tables/ssw.log",
     benchmark:
         f"{BENCH}/tables/ssw.tsv"
+    priority: 2
     conda:
         ENV
     params:
@@ -95,6 +99,7 @@ rule ssw_fits:
         f"{LOGS}/tables/ssw_fits.log",
     benchmark:
         f"{BENCH}/tables/ssw_fits.tsv"
+    priority: 1
     conda:
         ENV
     script:

@@ -96,33 +96,32 @@ def experiment_label(wildcards):
     return EXPERIMENT_LABEL
 
 
-def experiment_part(wildcards):
-    key = (wildcards.dataset, int(wildcards.N))
-    if key not in EXPERIMENT:
-        raise ValueError(
-            f"no experiment series {key[0]!r} with N = {key[1]} in this config; "
-            f"configured: {sorted(EXPERIMENT)}"
-        )
-    return EXPERIMENT[key]
-
-
 def raw_dataset(n):
     """Folder of the virtual experiment's dataset of the chain of n beads."""
     return f"{OUT}/experiment/raw/N{n}"
 
 
-def experiment_dataset_files(wildcards):
-    """What loading a dataset depends on: the virtual experiment's folder, or the
-    measured dataset's metadata.yaml and shot files (editing one reloads it)."""
-    part = experiment_part(wildcards)
-    if part.folder is None:
-        return [raw_dataset(part.n_beads)]
-    return list(part.files)
+def experiment_datasets():
+    """Each experiment dataset: its folder, series name, N and trace file."""
+    return [
+        {
+            "folder": raw_dataset(n) if part.folder is None else part.folder,
+            "name": name,
+            "N": n,
+            "traces": trace_file("experiment", name, n),
+        }
+        for (name, n), part in EXPERIMENT.items()
+    ]
 
 
-def experiment_dataset_folder(wildcards):
-    part = experiment_part(wildcards)
-    return raw_dataset(part.n_beads) if part.folder is None else part.folder
+def experiment_dataset_files():
+    """What loading the datasets depends on: the virtual experiment's folders, or the
+    measured datasets' metadata.yaml and shot files (editing one reloads them)."""
+    return [
+        path
+        for (name, n), part in EXPERIMENT.items()
+        for path in ([raw_dataset(n)] if part.folder is None else part.files)
+    ]
 
 
 def virtual_settings(wildcards):

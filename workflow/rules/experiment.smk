@@ -8,7 +8,7 @@
 #                                instead (their N and sensors from their metadata.yaml);
 #   experiment.source: none      nothing here runs, and Fig. 2 is not drawn.
 #
-# Then experiment_traces loads each dataset (chain.measured.load_dataset) into
+# Then experiment_traces loads the datasets (chain.measured.load_dataset) into
 # experiment/<name>_N<N>_traces.csv, which the pulses rule analyses with the simulated
 # traces; selection applies the 5 % amplitude match (chain.protocol.select_shots) and
 # writes experiment/selection.csv, which the delays and ssw rules use to drop rejected
@@ -24,6 +24,7 @@ rule virtual_experiment:
         f"{LOGS}/experiment/virtual_N{{N}}.log",
     benchmark:
         f"{BENCH}/experiment/virtual_N{{N}}.tsv"
+    priority: 3
     conda:
         ENV
     params:
@@ -33,22 +34,22 @@ rule virtual_experiment:
         "../scripts/virtual_experiment.py"
 
 
+# One job loads every dataset: a job costs ~2.5 s of Python start-up, a load ~1 s.
 rule experiment_traces:
     input:
-        dataset=experiment_dataset_files,
+        datasets=experiment_dataset_files(),
         lib=LIB_MEASURED,
     output:
-        f"{OUT}/experiment/{{dataset}}_N{{N}}_traces.csv",
+        experiment_trace_files(),
     log:
-        f"{LOGS}/experiment/{{dataset}}_N{{N}}_traces.log",
+        f"{LOGS}/experiment/traces.log",
     benchmark:
-        f"{BENCH}/experiment/{{dataset}}_N{{N}}_traces.tsv"
-    wildcard_constraints:
-        dataset="[A-Za-z][A-Za-z0-9_-]*",
+        f"{BENCH}/experiment/traces.tsv"
+    priority: 3
     conda:
         ENV
     params:
-        folder=experiment_dataset_folder,
+        datasets=experiment_datasets(),
     script:
         "../scripts/experiment_traces.py"
 
@@ -68,6 +69,7 @@ rule selection:
         f"{LOGS}/experiment/selection.log",
     benchmark:
         f"{BENCH}/experiment/selection.tsv"
+    priority: 2
     conda:
         ENV
     params:

@@ -12,6 +12,7 @@ rule simulate:
         f"{LOGS}/simulate/{{model}}_N{{N}}.log",
     benchmark:
         f"{BENCH}/simulate/{{model}}_N{{N}}.tsv"
+    priority: 2
     conda:
         ENV
     params:

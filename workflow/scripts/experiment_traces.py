@@ -1,4 +1,4 @@
-"""One experiment dataset (measured-trace format) as a trace table (chain.measured)."""
+"""Every experiment dataset (measured-trace format) as a trace table (chain.measured)."""
 
 from _logging import start
 
@@ -6,19 +6,20 @@ from chain.measured import load_dataset
 from chain.traces import write_traces
 
 log = start(snakemake)
-name, n_beads = snakemake.wildcards.dataset, int(snakemake.wildcards.N)
-table = load_dataset(snakemake.params.folder, name=name)
-if set(table["N"]) != {n_beads}:
-    raise ValueError(
-        f"{snakemake.params.folder}: N = {sorted(set(table['N']))}, expected {n_beads}"
+for dataset in snakemake.params.datasets:
+    table = load_dataset(dataset["folder"], name=dataset["name"])
+    if set(table["N"]) != {dataset["N"]}:
+        raise ValueError(
+            f"{dataset['folder']}: N = {sorted(set(table['N']))}, expected {dataset['N']}"
+        )
+    shots = table.drop_duplicates("shot")
+    log.info(
+        "%s -> %s: %d collision and %d reference shots, %d amplitudes",
+        dataset["folder"],
+        dataset["traces"],
+        int((shots["kind"] == "collision").sum()),
+        int((shots["kind"] == "reference").sum()),
+        shots["amplitude"].nunique(),
     )
-shots = table.drop_duplicates("shot")
-log.info(
-    "%s: %d collision and %d reference shots, %d amplitudes",
-    snakemake.params.folder,
-    int((shots["kind"] == "collision").sum()),
-    int((shots["kind"] == "reference").sum()),
-    shots["amplitude"].nunique(),
-)
-write_traces(table, snakemake.output[0])  # atomic: temporary file, then rename
+    write_traces(table, dataset["traces"])  # atomic: temporary file, then rename
 log.info("done")
