@@ -189,6 +189,7 @@ def test_markdown_other_material():
     assert "not the paper's beads" in text
     assert "— (the paper's beads are steel_100C6)" in text
     assert "vs paper's C_exp" not in text  # no comparison with measurements on steel
+    assert "not the paper's beads, so not comparable" in text  # the C_exp row says so
     assert "n/a (no conservative model)" in text
 
 

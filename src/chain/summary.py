@@ -441,7 +441,8 @@ def summary_markdown(summary: Mapping) -> str:
                 + ("; a model of the apparatus, not data" if "virtual" in label else "")
                 if _has_experiment(summary)
                 else "this run has no experiment"
-            ),
+            )
+            + ("" if steel else "; not the paper's beads, so not comparable"),
         ),
     ]
     fits = sorted(
