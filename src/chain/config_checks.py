@@ -246,7 +246,8 @@ def _check_experiment(config: Mapping) -> None:
     if duration < 10 * sampling:
         _fail(
             [*base, "duration_s"],
-            f"{duration:g} s holds fewer than 10 samples of sampling_interval_s = {sampling:g} s",
+            f"{duration:g} s holds fewer than 10 samples of sampling_interval_s = {sampling:g} s; "
+            f"allowed: >= {10 * sampling:g} s",
         )
     step = virtual.get("time_step_s")
     if step is not None and step > sampling:
