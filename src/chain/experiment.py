@@ -54,6 +54,7 @@ from chain.acquisition import (
     quantise,
     resample,
 )
+from chain.atomic import ordinary_mode, write_text_atomic
 from chain.materials import (
     Material,
     ParameterError,
@@ -64,12 +65,10 @@ from chain.materials import (
 from chain.measured import (
     FORMAT_NAME,
     METADATA_FILE,
-    default_mode,
     impact_speed_from_drop_height,
     read_metadata,
     write_metadata,
     write_shot_csv,
-    write_text_atomic,
 )
 from chain.model import PAPER_BEAD_RADIUS, PAPER_STRIKER_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
 from chain.simulation import default_time_step, simulate
@@ -511,7 +510,7 @@ def run_virtual_experiment(
     out.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
-        os.chmod(staging, default_mode(directory=True))
+        os.chmod(staging, ordinary_mode(directory=True))
         saturated = _write_shots(settings, plan, time, forces, rng, staging)
         if saturated.any():
             # A lab would re-range the digitiser; a clipped top biases the amplitude fit.

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -38,6 +37,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, FancyArrowPatch, FancyBboxPatch, Rectangle
 
+from chain.atomic import atomic_output
 from chain.summary import PAPER, usable_rows
 from chain.traces import sensor_beads, sensor_column
 
@@ -119,24 +119,10 @@ def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
             ("png", {"metadata": PNG_METADATA, "dpi": PNG_DPI}),
         ):
             target = stem.with_name(f"{stem.name}.{extension}")
-            handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
-            os.close(handle)
-            try:
+            with atomic_output(target) as temporary:
                 fig.savefig(temporary, format=extension, **options)
-                _readable(temporary)
-                os.replace(temporary, target)
-            except BaseException:
-                Path(temporary).unlink(missing_ok=True)
-                raise
             written.append(target)
     return written
-
-
-def _readable(path) -> None:
-    """Give a temporary file (created 0600) the permissions of an ordinary new file."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(path, 0o666 & ~umask)
 
 
 def _new_figure(width: float, height: float) -> Figure:

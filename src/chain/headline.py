@@ -14,6 +14,9 @@ import math
 import os
 from pathlib import Path
 
+from chain.delays import DELAY_FIT_COLUMNS
+from chain.ssw import SSW_FIT_COLUMNS
+
 #: Files of the results contract (design.md), relative to results/<run_name>/.
 CONTRACT_FIGURES = (
     "fig1_setup",
@@ -22,22 +25,13 @@ CONTRACT_FIGURES = (
     "fig5_ssw_vs_force",
 )
 EXPERIMENT_FIGURES = ("fig2_experiment_traces",)
+#: Contract columns of each table (the tables have more after these).
 CONTRACT_TABLES = {
     "pulses.csv": (),
     "delays.csv": ("source", "model", "N", "F_m_N", "delay_us"),
-    "delay_fits.csv": (
-        "source",
-        "model",
-        "N",
-        "estimator",
-        "C_us_N16",
-        "C_stderr_us_N16",
-        "exponent",
-        "exponent_stderr",
-        "n_points",
-    ),
+    "delay_fits.csv": DELAY_FIT_COLUMNS[: DELAY_FIT_COLUMNS.index("n_points") + 1],
     "ssw.csv": ("source", "model", "N", "F_m_N", "ssw_N"),
-    "ssw_fits.csv": ("source", "model", "N", "slope", "slope_stderr", "n_points"),
+    "ssw_fits.csv": SSW_FIT_COLUMNS[: SSW_FIT_COLUMNS.index("n_points") + 1],
 }
 SUMMARY_KEYS = ("run_name", "constants", "paper", "max_energy_drift", "delay_fits", "ssw_fits")
 

@@ -22,7 +22,6 @@ import io
 import itertools
 import math
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +31,7 @@ import pandas as pd
 import yaml
 
 from chain.acquisition import volts_to_newtons
+from chain.atomic import write_text_atomic
 from chain.traces import KINDS, META_COLUMNS, sensor_column, validate_traces
 
 #: Name of the metadata file of a dataset.
@@ -581,37 +581,6 @@ def load_dataset(folder: str | os.PathLike, name: str | None = None) -> pd.DataF
 
 
 # ----------------------------------------------------------------------------- writers
-
-
-def default_mode(directory: bool = False) -> int:
-    """Permission bits a plain ``open``/``mkdir`` would give under the current umask
-    (``tempfile`` creates private 0600/0700 entries, wrong for shared data)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return (0o777 if directory else 0o666) & ~umask
-
-
-def write_text_atomic(text: str, path: str | os.PathLike) -> None:
-    """Write ``text`` to a temporary name beside ``path``, then rename it to ``path``.
-
-    Parameters
-    ----------
-    text : str
-        File content (UTF-8, written as is).
-    path : path
-        Destination; parent folders are created.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        os.chmod(temporary, default_mode())
-        with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
-            stream.write(text)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
 def write_shot_csv(path: str | os.PathLike, time_s, volts_V, sensor_beads: Sequence[int]) -> None:

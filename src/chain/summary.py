@@ -13,13 +13,12 @@ import json
 import logging
 import math
 import os
-import tempfile
 from collections.abc import Iterable, Mapping
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from chain.atomic import write_text_atomic
 from chain.materials import contact_stiffness, get_material, sphere_mass
 from chain.theory import (
     HERTZ_TIME_CONSTANT,
@@ -690,22 +689,6 @@ def _experiment_c(summary, main, label="experiment") -> str:
     )
 
 
-def _write_text_atomic(text: str, path: str | os.PathLike) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8", newline="\n") as stream:
-            stream.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
 def write_summary(
     summary: Mapping, json_path: str | os.PathLike, markdown_path: str | os.PathLike
 ) -> None:
@@ -718,5 +701,5 @@ def write_summary(
     json_path, markdown_path : path
         Destinations.
     """
-    _write_text_atomic(summary_json(summary), json_path)
-    _write_text_atomic(summary_markdown(summary), markdown_path)
+    write_text_atomic(summary_json(summary), json_path)
+    write_text_atomic(summary_markdown(summary), markdown_path)

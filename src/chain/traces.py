@@ -27,11 +27,12 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from chain.atomic import atomic_output
 
 #: Columns every trace table has, in order, before the sensor columns.
 META_COLUMNS = (
@@ -183,10 +184,9 @@ def iter_shots(table: pd.DataFrame):
 
 
 def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
-    """Write ``table`` as CSV to a temporary name beside ``path`` and rename it, so that
-    an interrupted write never leaves a partial file under the final name. The file
-    gets the permissions of an ordinary new file (``0o666`` less the umask), not the
-    ``0o600`` of a temporary file.
+    """Write ``table`` as CSV (fixed float format, ``\\n`` line ends) atomically: an
+    interrupted write never leaves a partial file under the final name
+    (:func:`chain.atomic.atomic_output`).
 
     Parameters
     ----------
@@ -195,21 +195,5 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     path : path
         Destination; parent folders are created.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w", newline="") as stream:
-            table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
-        _ordinary_permissions(temporary)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
-def _ordinary_permissions(path: str | os.PathLike) -> None:
-    """Give a temporary file (created 0600 by mkstemp) the permissions ``open`` gives."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(path, 0o666 & ~umask)
+    with atomic_output(path) as temporary, open(temporary, "w", newline="") as stream:
+        table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")

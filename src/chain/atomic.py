@@ -1,0 +1,72 @@
+"""Atomic file writes: write to a temporary name beside the target, then rename.
+
+An interrupted job (Ctrl-C, a killed Snakemake job, a full disk) therefore never leaves
+a half-written file under the final name; ``os.replace`` is atomic on POSIX file
+systems. Every file the library writes goes through :func:`atomic_output`.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+
+def ordinary_mode(directory: bool = False) -> int:
+    """Permission bits a plain ``open``/``mkdir`` would give under the current umask.
+
+    ``tempfile`` creates private 0600/0700 entries, wrong for shared results.
+
+    Parameters
+    ----------
+    directory : bool
+        Bits for a folder (0777 less the umask) instead of a file (0666 less the umask).
+    """
+    umask = os.umask(0)
+    os.umask(umask)
+    return (0o777 if directory else 0o666) & ~umask
+
+
+@contextmanager
+def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success rename it to ``path``.
+
+    Write the file to the yielded path inside the ``with`` block. If the block raises
+    (or the process is interrupted by an exception such as KeyboardInterrupt), the
+    temporary file is removed and ``path`` is left as it was.
+
+    Parameters
+    ----------
+    path : path
+        Final destination; parent folders are created.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    os.close(handle)
+    try:
+        yield Path(temporary)
+        os.chmod(temporary, ordinary_mode())
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def write_text_atomic(text: str, path: str | os.PathLike) -> None:
+    """Write ``text`` (UTF-8, line endings as given) to ``path`` atomically.
+
+    Parameters
+    ----------
+    text : str
+        File content.
+    path : path
+        Destination; parent folders are created.
+    """
+    with (
+        atomic_output(path) as temporary,
+        open(temporary, "w", encoding="utf-8", newline="") as stream,
+    ):
+        stream.write(text)
