@@ -45,7 +45,7 @@ from chain import (
     sphere_mass,
     uniform_chain,
 )
-from chain.simulation import STEPS_PER_CONTACT_TIME
+from chain.physics.simulation import STEPS_PER_CONTACT_TIME
 
 N_BEADS = 26
 DURATION = 2.6e-3  # s, the paper's run

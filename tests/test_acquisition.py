@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from chain.acquisition import (
+from chain.apparatus.acquisition import (
     PCB_200B02_RANGE_N,
     PCB_200B02_SENSITIVITY_MV_PER_N,
     adc_step,
@@ -15,7 +15,7 @@ from chain.acquisition import (
     sampling_instants,
     volts_to_newtons,
 )
-from chain.materials import ParameterError
+from chain.errors import ParameterError
 
 
 def test_pcb_200b02_full_scale_is_five_volts():

@@ -13,10 +13,10 @@ import pandas as pd
 import pytest
 
 import chain
-from chain.delays import delay_fit_table, delay_table
-from chain.pulses import pulse_table
-from chain.ssw import ssw_fit_table, ssw_table
-from chain.theory import ballistic_delay_constant_exact
+from chain.analysis.delays import delay_fit_table, delay_table
+from chain.analysis.pulses import pulse_table
+from chain.analysis.ssw import ssw_fit_table, ssw_table
+from chain.physics.theory import ballistic_delay_constant_exact
 
 #: Launch speeds: F_m from ~9 N to ~1 kN at the first sensor.
 SPEEDS_M_S = np.geomspace(0.02, 1.0, 7)

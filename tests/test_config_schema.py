@@ -1,5 +1,5 @@
 """The pipeline's config: the JSON schema (workflow/schemas/config.schema.yaml), the
-semantic checks of chain.config_checks, and the shipped configs (config.yaml, whatif/).
+semantic checks of chain.pipeline.config, and the shipped configs (config.yaml, whatif/).
 
 A bad config must stop before any job runs, with a message naming the key.
 """
@@ -16,9 +16,9 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
-from chain.config_checks import ConfigError, check_config, experiment_parts, key_name
-from chain.materials import MATERIALS
-from chain.pulses import ESTIMATORS
+from chain.analysis.pulses import ESTIMATORS
+from chain.physics.materials import MATERIALS
+from chain.pipeline.config import ConfigError, check_config, experiment_parts, key_name
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -120,8 +120,8 @@ def test_paper_experiment_is_the_virtual_one_and_modest(paper):
 def test_virtual_settings_map_onto_the_virtual_experiment(paper):
     from dataclasses import fields
 
-    from chain.config_checks import VIRTUAL_FIELDS, virtual_experiment_settings
-    from chain.experiment import VirtualExperiment
+    from chain.apparatus.virtual import VirtualExperiment
+    from chain.pipeline.config import VIRTUAL_FIELDS, virtual_experiment_settings
 
     schema = load(SCHEMA)["properties"]["experiment"]["properties"]["virtual"]["properties"]
     assert set(VIRTUAL_FIELDS) == set(schema)
@@ -137,7 +137,7 @@ def test_virtual_settings_map_onto_the_virtual_experiment(paper):
 
 
 def test_experiment_parts_and_labels(paper):
-    from chain.config_checks import experiment_label
+    from chain.pipeline.config import experiment_label
 
     config = validated(paper)
     virtual = experiment_parts(config)
@@ -167,7 +167,8 @@ def test_experiment_parts_and_labels(paper):
 def test_duration_check_has_margin_on_the_shipped_configs(paper):
     """The estimate behind the duration check, against the paper run: the slowest
     simulated wave (0.021 m/s) and striker wave (0.4 m/s) of the N = 26 chain."""
-    from chain.config_checks import DURATION_MARGIN, pulse_passing_time
+    from chain.physics.theory import pulse_passing_time
+    from chain.pipeline.config import DURATION_MARGIN
 
     slow = pulse_passing_time("steel_100C6", 0.013, 26, [10, 17], 0.021)
     # The simulation measures F_m = 10.0 N; the estimate is a little lower (slower).
@@ -211,7 +212,7 @@ def test_every_key_is_described_and_closed():
 
 def config_error(config: dict) -> str:
     """The message that stops ``config``: the schema's (snakemake.utils.validate), else
-    chain.config_checks' (check_config, then experiment_parts, as the Snakefile runs
+    chain.pipeline.config' (check_config, then experiment_parts, as the Snakefile runs
     them); fails the test if the config passes."""
     config = copy.deepcopy(config)
     try:
@@ -224,7 +225,7 @@ def config_error(config: dict) -> str:
 
 
 def key(name: str) -> str:
-    """How chain.config_checks names a key."""
+    """How chain.pipeline.config names a key."""
     return f"config key '{name}': "
 
 
@@ -352,7 +353,7 @@ BAD_CONFIGS = {
         on("figures", "parity_ssw_vs_N"),
         "is not of type 'boolean'",
     ),
-    # -- relations between keys (chain.config_checks.check_config) --
+    # -- relations between keys (chain.pipeline.config.check_config) --
     "sensor inside 1..N": (
         setter("chains", 0, "sensors", value=[9, 30]),
         key("chains[0].sensors[1]"),

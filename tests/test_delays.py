@@ -8,9 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.delays import DELAY_COLUMNS, DELAY_FIT_COLUMNS, delay_fit_table, delay_table
-from chain.pulses import pulse_table
-from chain.theory import cos6_pulse
+from chain.analysis.delays import DELAY_COLUMNS, DELAY_FIT_COLUMNS, delay_fit_table, delay_table
+from chain.analysis.pulses import pulse_table
+from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
 TIME_S = np.arange(0.0, 1200e-6, 1e-6)

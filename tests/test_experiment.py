@@ -10,9 +10,12 @@ import pandas as pd
 import pytest
 import yaml
 
-from chain.acquisition import adc_step, volts_to_newtons
-from chain.delays import delay_fit_table, delay_table
-from chain.experiment import (
+from chain.analysis.delays import delay_fit_table, delay_table
+from chain.analysis.pulses import pulse_table
+from chain.analysis.selection import select_shots
+from chain.apparatus.acquisition import adc_step, volts_to_newtons
+from chain.apparatus.measured import METADATA_FILE, load_dataset
+from chain.apparatus.virtual import (
     TRUTH_FILE,
     VIRTUAL_LABEL,
     VirtualExperiment,
@@ -20,10 +23,7 @@ from chain.experiment import (
     run_virtual_experiment,
     simulate_virtual_shots,
 )
-from chain.materials import ParameterError
-from chain.measured import METADATA_FILE, load_dataset
-from chain.protocol import select_shots
-from chain.pulses import pulse_table
+from chain.errors import ParameterError
 
 EXAMPLE = Path(__file__).parent / "data" / "virtual_small"
 

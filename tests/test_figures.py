@@ -1,4 +1,4 @@
-"""Figure functions (chain.figures) on small synthetic tables: they return Figures,
+"""Figure functions (chain.report.figures) on small synthetic tables: they return Figures,
 draw what the captions say, and save byte-identical PDF/PNG files."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from chain import figures
-from chain.theory import cos6_pulse
+from chain.physics.theory import cos6_pulse
+from chain.report import figures
 from chain.traces import sensor_column, validate_traces
 
 #: Synthetic pulse: duration tau and the arrival times of the incident and crossed
@@ -385,7 +385,7 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     experiment = delays.index[delays["source"] == "experiment"]
     delays.loc[experiment[:3], "ok"] = False  # flagged
     delays.loc[experiment[3], "delay_us"] = math.nan  # ok but NaN: a bug upstream
-    with caplog.at_level("INFO", logger="chain.summary"):
+    with caplog.at_level("INFO", logger="chain.analysis.rows"):
         fig = figures.fig4_delay_vs_force(delays, experiment_label="x")
     drawn = sum(
         len(line.get_xdata())
@@ -400,7 +400,7 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     ssw.loc[1, "ssw_N"] = math.nan
     ssw.loc[2, "ssw_N"] = -0.1  # below the noise: not on a log axis
     caplog.clear()
-    with caplog.at_level("INFO", logger="chain.summary"):
+    with caplog.at_level("INFO", logger="chain.analysis.rows"):
         fig = figures.fig5_ssw_vs_force(ssw, fits)
     points = [line for line in fig.get_axes()[0].get_lines() if line.get_linestyle() == "None"]
     assert sum(len(line.get_xdata()) for line in points) == len(ssw) - 3

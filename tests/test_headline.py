@@ -1,4 +1,4 @@
-"""The CI check of headline numbers and contract files (chain.headline)."""
+"""The CI check of headline numbers and contract files (chain.pipeline.headline)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import json
 import pandas as pd
 import pytest
 
-from chain import headline
 from chain.cli import main
+from chain.pipeline import headline
 
 
 def _summary() -> dict:

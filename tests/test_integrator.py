@@ -20,7 +20,7 @@ from chain import (
     sphere_mass,
     uniform_chain,
 )
-from chain.theory import hertz_contact_time, hertz_peak_force
+from chain.physics.theory import hertz_contact_time, hertz_peak_force
 
 
 class ReferenceChain:

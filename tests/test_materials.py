@@ -15,7 +15,7 @@ from chain import (
     get_material,
     sphere_mass,
 )
-from chain.materials import BRASS
+from chain.physics.materials import BRASS
 
 
 def test_theta_is_the_papers_compliance(steel, tol):

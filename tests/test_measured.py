@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from chain.measured import (
+from chain.apparatus.measured import (
     METADATA_FILE,
     STANDARD_GRAVITY,
     MeasuredDataError,

@@ -17,7 +17,7 @@ from chain import (
     sphere_mass,
     uniform_chain,
 )
-from chain.model import HERTZ, SPRING
+from chain.physics.model import HERTZ, SPRING
 
 
 def test_uniform_chain_is_eq1(bead_mass, kappa, tol):

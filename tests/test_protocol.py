@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.materials import ParameterError
-from chain.protocol import SELECTION_COLUMNS, amplitude_mismatch, select_shots
+from chain.analysis.selection import SELECTION_COLUMNS, amplitude_mismatch, select_shots
+from chain.errors import ParameterError
 
 
 def _pulse(shot, kind, sensor, role, force, ok=True, reason="", estimator="fit_full"):

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.pulses import (
+from chain.analysis.pulses import (
     COS6_FWHM_PER_TAU,
     ESTIMATORS,
     PULSE_COLUMNS,
@@ -17,7 +17,7 @@ from chain.pulses import (
     fit_pulse,
     pulse_table,
 )
-from chain.theory import cos6_pulse
+from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
 # A pulse like the paper's at ~500 N (tau ~ 80 us) sampled at 1 MHz, SNR 100.

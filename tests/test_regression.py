@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from chain.regression import fit_fixed_exponent, fit_power_law, fit_proportional
+from chain.analysis.regression import fit_fixed_exponent, fit_power_law, fit_proportional
 
 # Delta = C F_m^(-1/6) over the paper's range of forces.
 C_TRUE = 45.9  # us N^(1/6)

@@ -70,12 +70,12 @@ import pandas as pd
 import pytest
 
 from chain import default_time_step, simulate, simulate_shots, uniform_chain
-from chain.delays import delay_fit_table, delay_table
-from chain.integrator import IntegrationError
-from chain.materials import ParameterError
-from chain.pulses import find_pulses, pulse_table
-from chain.ssw import ssw_fit_table, ssw_table
-from chain.theory import cos6_pulse
+from chain.analysis.delays import delay_fit_table, delay_table
+from chain.analysis.pulses import find_pulses, pulse_table
+from chain.analysis.ssw import ssw_fit_table, ssw_table
+from chain.errors import ParameterError
+from chain.physics.integrator import IntegrationError
+from chain.physics.theory import cos6_pulse
 from chain.traces import (
     META_COLUMNS,
     sensor_column,
@@ -482,7 +482,7 @@ def test_a_failing_figure_save_leaves_no_file(tmp_path, monkeypatch):
     writing part of the file leaves nothing under the final names."""
     from matplotlib.figure import Figure
 
-    from chain.figures import save_figure
+    from chain.report.figures import save_figure
 
     fig = Figure()
     fig.add_subplot().plot([0, 1], [1, 0])
@@ -498,14 +498,16 @@ def test_a_failing_figure_save_leaves_no_file(tmp_path, monkeypatch):
 
 
 def test_a_failing_summary_leaves_no_partial_file(tmp_path, monkeypatch):
-    import chain.summary
+    import chain.report.summary
 
     def fail(summary):
         raise RuntimeError("bad summary")
 
-    monkeypatch.setattr(chain.summary, "summary_markdown", fail)
+    monkeypatch.setattr(chain.report.summary, "summary_markdown", fail)
     with pytest.raises(RuntimeError, match="bad summary"):
-        chain.summary.write_summary({"run_name": "x"}, tmp_path / "s.json", tmp_path / "s.md")
+        chain.report.summary.write_summary(
+            {"run_name": "x"}, tmp_path / "s.json", tmp_path / "s.md"
+        )
     # The JSON is complete on its own; the Markdown never appears, even partly.
     assert listing(tmp_path) == ["s.json"]
     assert json.loads((tmp_path / "s.json").read_text()) == {"run_name": "x"}
@@ -517,7 +519,7 @@ TERMINATED_JOB = textwrap.dedent(
     import os, signal, sys, types
     import pandas as pd
     sys.path.insert(0, sys.argv[1])
-    from chain.traces import write_csv_atomic
+    from chain.atomic import write_csv_atomic
     folder = sys.argv[2]
     if sys.argv[3] == "start":
         import _logging
@@ -697,13 +699,13 @@ def test_unconverged_fits_are_flagged_and_left_out(monkeypatch):
     """curve_fit failing on every pulse: the fit_full rows are flagged 'fit did not
     converge', their delays flagged, their fits empty; the peak estimator, which does
     not fit, is unaffected."""
-    import chain.pulses
+    import chain.analysis.pulses
 
     def no_convergence(*args, **kwargs):
         raise RuntimeError("Optimal parameters not found: maxfev reached")
 
     traces = shot_table(crossing_shots())
-    monkeypatch.setattr(chain.pulses, "curve_fit", no_convergence)
+    monkeypatch.setattr(chain.analysis.pulses, "curve_fit", no_convergence)
     pulses = pulse_table(traces, estimators=("fit_full", "peak"))
     fitted = pulses[pulses["estimator"] == "fit_full"]
     all_flagged(fitted, ["F_m_N", "T_s"])

@@ -14,7 +14,7 @@ from chain import (
     simulate,
     uniform_chain,
 )
-from chain.theory import (
+from chain.physics.theory import (
     hertz_contact_time,
     hertz_peak_force,
     nesterenko_speed_from_force,

@@ -6,9 +6,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.pulses import pulse_table
-from chain.ssw import SSW_COLUMNS, SSW_FIT_COLUMNS, ssw_fit_table, ssw_table
-from chain.theory import cos6_pulse
+from chain.analysis.pulses import pulse_table
+from chain.analysis.ssw import SSW_COLUMNS, SSW_FIT_COLUMNS, ssw_fit_table, ssw_table
+from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
 TIME_S = np.arange(0.0, 1400e-6, 1e-6)

@@ -1,4 +1,4 @@
-"""summary.json / summary.md (chain.summary) from synthetic tables."""
+"""summary.json / summary.md (chain.report.summary) from synthetic tables."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.summary import (
-    PAPER,
+from chain.physics.theory import ballistic_constants as run_constants
+from chain.report.paper import PAPER
+from chain.report.summary import (
     build_summary,
-    run_constants,
     summary_json,
     summary_markdown,
     write_summary,
@@ -221,11 +221,11 @@ def delays_with_flags() -> pd.DataFrame:
 
 
 def test_usable_rows_drops_flagged_and_nan_and_logs_the_count(caplog):
-    from chain.summary import usable_rows
+    from chain.analysis.rows import usable_rows
 
     table = delays_with_flags()
     table.loc[6, "delay_us"] = math.nan  # ok, but NaN: must not pass quietly
-    with caplog.at_level("INFO", logger="chain.summary"):
+    with caplog.at_level("INFO", logger="chain.analysis.rows"):
         kept = usable_rows(table, ["F_m_N", "delay_us"], "delay rows")
     assert list(kept.index) == [0, 1, 2, 5]
     assert "delay rows: 3 of 7 left out (2 flagged ok = False, 1 ok but NaN/inf" in caplog.text

@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import quad
 
 from chain import ParameterError
-from chain.theory import (
+from chain.physics.theory import (
     HERTZ_TIME_CONSTANT,
     PAPER_TIME_CONSTANT,
     ballistic_delay,

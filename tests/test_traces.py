@@ -14,7 +14,7 @@ from chain import (
     validate_traces,
     write_traces,
 )
-from chain.simulation import trace_table
+from chain.apparatus.shots import trace_table
 from chain.traces import META_COLUMNS, iter_shots, sensor_beads, sensor_column
 
 

@@ -30,6 +30,9 @@ SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 pytestmark = pytest.mark.workflow
 
+#: Not copied into a work tree: caches and earlier results.
+IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", "results", ".snakemake")
+
 #: Columns each contract table must have (results contract + docs/interfaces.md).
 TABLE_COLUMNS = {
     "pulses": [
@@ -63,8 +66,11 @@ def env() -> dict:
 
 
 def run(args, work: Path, env: dict, timeout=600) -> subprocess.CompletedProcess:
+    """Snakemake in ``work``, with the work tree's own Snakefile if it has one (a copied
+    checkout), else the repository's."""
+    snakefile = work / "Snakefile" if (work / "Snakefile").exists() else ROOT / "Snakefile"
     return subprocess.run(
-        [*SNAKEMAKE, "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work), *args],
+        [*SNAKEMAKE, "--snakefile", str(snakefile), "--directory", str(work), *args],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -85,16 +91,18 @@ def planned_jobs(work: Path, env: dict) -> dict[str, int]:
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    """The tiny run, done once: (work directory, results directory, env)."""
-    base = tmp_path_factory.mktemp("workflow")
-    work = base / "work"
+    """The tiny run, done once in a copy of the checkout (Snakefile, workflow, config,
+    library), so that tests can edit its library: (work directory, results directory,
+    env, library folder)."""
+    work = tmp_path_factory.mktemp("workflow") / "checkout"
     work.mkdir()
-    shutil.copy(ROOT / "config.yaml", work / "config.yaml")
-    library = base / "lib" / "chain"
-    source = ROOT / "src" / "chain"
+    for name in ("config.yaml", "Snakefile"):
+        shutil.copy(ROOT / name, work / name)
+    shutil.copytree(ROOT / "workflow", work / "workflow", ignore=IGNORED)
+    library = work / "src" / "chain"
     # copy2 keeps mtimes, so numba's cache of the integrator stays valid in the copy.
-    shutil.copytree(source, library, copy_function=shutil.copy2)
-    env = {**os.environ, "PYTHONPATH": str(base / "lib")}
+    shutil.copytree(ROOT / "src" / "chain", library, copy_function=shutil.copy2)
+    env = {**os.environ, "PYTHONPATH": str(work / "src")}
     result = run(["--cores", "2", "--configfile", str(TINY)], work, env)
     assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
     return work, work / "results" / "tiny", env, library
@@ -223,17 +231,20 @@ def test_second_run_has_nothing_to_do(tiny):
 @pytest.mark.parametrize(
     ("module", "expected", "untouched"),
     [
-        ("figures", set(FIGURES) | {"all"},
+        ("report/figures", set(FIGURES) | {"all"},
          {"simulate", "virtual_experiment", "pulses", "selection", "summary"}),
-        ("ssw", {"ssw", "ssw_fits", "fig2_experiment_traces", "fig3_simulation_traces",
-                 "fig5_ssw_vs_force", "summary"},
+        ("analysis/ssw", {"ssw", "ssw_fits", "fig2_experiment_traces", "fig3_simulation_traces",
+                          "fig5_ssw_vs_force", "summary"},
          {"simulate", "virtual_experiment", "experiment_traces", "pulses", "selection",
           "delays"}),
-        ("protocol", {"selection", "delays", "ssw", "fig2_experiment_traces", "summary"},
+        ("analysis/selection", {"selection", "delays", "ssw", "fig2_experiment_traces",
+                                "summary"},
          {"simulate", "virtual_experiment", "experiment_traces", "pulses"}),
-        ("experiment", {"virtual_experiment", "experiment_traces", "pulses", "selection"},
+        ("apparatus/virtual", {"virtual_experiment", "experiment_traces", "pulses",
+                               "selection"},
          {"simulate", "fig1_setup"}),
-        ("model", {"simulate", "virtual_experiment", "pulses", "delays", "ssw", "summary"},
+        ("physics/model", {"simulate", "virtual_experiment", "pulses", "delays", "ssw",
+                           "summary"},
          set()),
     ],
 )  # fmt: skip
@@ -250,10 +261,19 @@ def test_editing_the_library_reruns_what_depends_on_it(tiny, module, expected, u
         os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
     assert expected <= set(jobs), jobs
     assert not untouched & set(jobs), jobs
-    if module == "model":
+    if module == "physics/model":
         assert jobs["simulate"] == 4 and jobs["virtual_experiment"] == 2
-    if module == "experiment":
+    if module == "apparatus/virtual":
         assert jobs["virtual_experiment"] == 2
+
+
+def test_a_copied_checkout_has_nothing_to_do(tiny, tmp_path):
+    """The rules name the library by paths relative to the working directory, so a
+    built run copied elsewhere (a CI cache, a colleague's copy) is up to date there."""
+    work, _, _, _ = tiny
+    copy = tmp_path / "elsewhere" / "checkout"
+    shutil.copytree(work, copy, symlinks=True, copy_function=shutil.copy2)
+    assert planned_jobs(copy, {**os.environ, "PYTHONPATH": str(copy / "src")}) == {}
 
 
 @pytest.fixture(scope="module")

@@ -1,76 +1,61 @@
 """hertzchain: solitary-wave collisions in Hertzian bead chains (Santibanez et al.).
 
 The library behind the pipeline; it knows nothing of Snakemake or config files.
+Its wings, each importing only the ones below it (``tests/test_layering.py``):
+
+* :mod:`chain.errors`, :mod:`chain.atomic`, :mod:`chain.traces`, :mod:`chain.labels`:
+  the error type and input checks, atomic writes, the one trace format, labels;
+* :mod:`chain.physics`: materials, chain model, integrator, closed forms;
+* :mod:`chain.apparatus`: simulated shots, acquisition, virtual experiment, measured data;
+* :mod:`chain.analysis`: pulses, selection, delays, SSW, regression, row hygiene;
+* :mod:`chain.report`: figures and the summary;
+* :mod:`chain.pipeline`: config checks and the headline check (the only config-aware code).
+
+The public names below are imported on first use, so ``import chain`` is cheap.
 """
 
-from chain.delays import delay_fit_table, delay_table
-from chain.integrator import IntegrationError, integrate
-from chain.materials import (
-    MATERIALS,
-    STEEL_100C6,
-    Material,
-    ParameterError,
-    contact_stiffness,
-    get_material,
-    sphere_mass,
-)
-from chain.model import (
-    PCB_200B02_STIFFNESS,
-    ChainModel,
-    Striker,
-    build_chain,
-    launch_velocities,
-    uniform_chain,
-)
-from chain.pulses import ESTIMATORS, PulseFit, find_pulses, fit_pulse, pulse_table
-from chain.regression import fit_fixed_exponent, fit_power_law, fit_proportional
-from chain.simulation import (
-    SimulationResult,
-    default_time_step,
-    simulate,
-    simulate_shots,
-    trace_table,
-)
-from chain.ssw import ssw_fit_table, ssw_table
-from chain.traces import TraceFormatError, read_traces, validate_traces, write_traces
+from chain._lazy import lazy_exports
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "ESTIMATORS",
-    "MATERIALS",
-    "PCB_200B02_STIFFNESS",
-    "STEEL_100C6",
-    "ChainModel",
-    "IntegrationError",
-    "Material",
-    "ParameterError",
-    "PulseFit",
-    "SimulationResult",
-    "Striker",
-    "TraceFormatError",
-    "build_chain",
-    "contact_stiffness",
-    "default_time_step",
-    "delay_fit_table",
-    "delay_table",
-    "find_pulses",
-    "fit_fixed_exponent",
-    "fit_power_law",
-    "fit_proportional",
-    "fit_pulse",
-    "get_material",
-    "integrate",
-    "launch_velocities",
-    "pulse_table",
-    "read_traces",
-    "simulate",
-    "simulate_shots",
-    "sphere_mass",
-    "ssw_fit_table",
-    "ssw_table",
-    "trace_table",
-    "uniform_chain",
-    "validate_traces",
-    "write_traces",
-]
+__getattr__, __dir__, __all__ = lazy_exports(
+    __name__,
+    {
+        "ChainModel": "chain.physics.model",
+        "ESTIMATORS": "chain.analysis.pulses",
+        "IntegrationError": "chain.physics.integrator",
+        "MATERIALS": "chain.physics.materials",
+        "Material": "chain.physics.materials",
+        "PCB_200B02_STIFFNESS": "chain.physics.model",
+        "ParameterError": "chain.errors",
+        "PulseFit": "chain.analysis.pulses",
+        "STEEL_100C6": "chain.physics.materials",
+        "SimulationResult": "chain.physics.simulation",
+        "Striker": "chain.physics.model",
+        "TraceFormatError": "chain.traces",
+        "build_chain": "chain.physics.model",
+        "contact_stiffness": "chain.physics.materials",
+        "default_time_step": "chain.physics.simulation",
+        "delay_fit_table": "chain.analysis.delays",
+        "delay_table": "chain.analysis.delays",
+        "find_pulses": "chain.analysis.pulses",
+        "fit_fixed_exponent": "chain.analysis.regression",
+        "fit_power_law": "chain.analysis.regression",
+        "fit_proportional": "chain.analysis.regression",
+        "fit_pulse": "chain.analysis.pulses",
+        "get_material": "chain.physics.materials",
+        "integrate": "chain.physics.integrator",
+        "launch_velocities": "chain.physics.model",
+        "pulse_table": "chain.analysis.pulses",
+        "read_traces": "chain.traces",
+        "simulate": "chain.physics.simulation",
+        "simulate_shots": "chain.apparatus.shots",
+        "sphere_mass": "chain.physics.materials",
+        "ssw_fit_table": "chain.analysis.ssw",
+        "ssw_table": "chain.analysis.ssw",
+        "trace_table": "chain.apparatus.shots",
+        "uniform_chain": "chain.physics.model",
+        "validate_traces": "chain.traces",
+        "write_traces": "chain.traces",
+    },
+)

@@ -8,10 +8,15 @@ systems. Every file the library writes goes through :func:`atomic_output`.
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def ordinary_mode(directory: bool = False) -> int:
@@ -70,3 +75,36 @@ def write_text_atomic(text: str, path: str | os.PathLike) -> None:
         open(temporary, "w", encoding="utf-8", newline="") as stream,
     ):
         stream.write(text)
+
+
+#: CSV float format: 10 significant digits, ample for forces and times, and fixed bytes.
+FLOAT_FORMAT = "%.10g"
+
+
+def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Write ``table`` as CSV (fixed float format, ``\\n`` line ends) atomically: an
+    interrupted write never leaves a partial file under the final name
+    (:func:`atomic_output`).
+
+    Parameters
+    ----------
+    table : DataFrame
+        Any table.
+    path : path
+        Destination; parent folders are created.
+    """
+    with atomic_output(path) as temporary, open(temporary, "w", newline="") as stream:
+        table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
+
+
+def replace_folder(staging: Path, out: Path) -> None:
+    """Move ``staging`` to ``out``; an existing ``out`` (a dataset) is swapped out first
+    and deleted, so a reader sees the old dataset or the new one, never a mixture."""
+    if not out.exists():
+        os.replace(staging, out)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
+    old.rmdir()
+    os.replace(out, old)
+    os.replace(staging, out)
+    shutil.rmtree(old, ignore_errors=True)

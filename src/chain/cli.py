@@ -10,10 +10,12 @@ import json
 import sys
 from collections.abc import Sequence
 
-from chain.integrator import IntegrationError
-from chain.materials import MATERIALS, ParameterError, contact_stiffness, get_material, sphere_mass
-from chain.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
-from chain.simulation import DEFAULT_RECORD_INTERVAL, simulate, trace_table
+from chain.apparatus.shots import trace_table
+from chain.errors import ParameterError
+from chain.physics.integrator import IntegrationError
+from chain.physics.materials import MATERIALS, contact_stiffness, get_material, sphere_mass
+from chain.physics.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
+from chain.physics.simulation import DEFAULT_RECORD_INTERVAL, simulate
 from chain.traces import TraceFormatError, write_traces
 
 _DESCRIPTION = """\
@@ -162,7 +164,7 @@ def _build_parser() -> argparse.ArgumentParser:
 def _check(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from chain import headline
+    from chain.pipeline import headline
 
     folder = Path(args.run_folder)
     summary_path = folder / "summary.json"
@@ -225,12 +227,12 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _analyse(args: argparse.Namespace) -> int:
-    from chain.pulses import pulse_table  # analysis is imported only when asked for
+    from chain.analysis.pulses import pulse_table  # analysis is imported only when asked for
     from chain.traces import read_traces
 
     table = pulse_table(read_traces(args.traces), estimators=(args.estimator,))
     if args.output:
-        from chain.traces import write_csv_atomic
+        from chain.atomic import write_csv_atomic
 
         write_csv_atomic(table, args.output)
     else:
@@ -239,7 +241,7 @@ def _analyse(args: argparse.Namespace) -> int:
 
 
 def _theory(args: argparse.Namespace) -> int:
-    from chain import theory
+    from chain.physics import theory
 
     material = get_material(args.material)
     radius = args.radius

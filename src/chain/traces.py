@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from chain.atomic import atomic_output
+from chain.atomic import write_csv_atomic
 
 #: Columns every trace table has, in order, before the sensor columns.
 META_COLUMNS = (
@@ -49,8 +49,6 @@ META_COLUMNS = (
 SOURCES = ("simulation", "experiment")
 KINDS = ("collision", "reference")
 _SENSOR_COLUMN = re.compile(r"^force_bead(\d+)_N$")
-#: CSV float format: 10 significant digits, ample for forces and times, and fixed bytes.
-FLOAT_FORMAT = "%.10g"
 
 
 class TraceFormatError(ValueError):
@@ -181,19 +179,3 @@ def iter_shots(table: pd.DataFrame):
         meta = {c: first[c] for c in META_COLUMNS if c != "t_s"}
         forces = {b: group[sensor_column(b)].to_numpy() for b in beads}
         yield int(shot), meta, group["t_s"].to_numpy(), forces
-
-
-def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
-    """Write ``table`` as CSV (fixed float format, ``\\n`` line ends) atomically: an
-    interrupted write never leaves a partial file under the final name
-    (:func:`chain.atomic.atomic_output`).
-
-    Parameters
-    ----------
-    table : DataFrame
-        Any table.
-    path : path
-        Destination; parent folders are created.
-    """
-    with atomic_output(path) as temporary, open(temporary, "w", newline="") as stream:
-        table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")

@@ -7,7 +7,7 @@
 rule pulses:
     input:
         traces=all_trace_files,
-        lib=LIB_PULSES,
+        lib=code("pulses"),
     output:
         report(
             f"{TABLES}/pulses.csv", caption="../report/pulses.rst", category="Tables"
@@ -29,7 +29,7 @@ rule delays:
     input:
         pulses=f"{TABLES}/pulses.csv",
         selection=selection_files,
-        lib=LIB_DELAYS,
+        lib=code("delays"),
     output:
         f"{TABLES}/delays.csv",
     log:
@@ -46,7 +46,7 @@ rule delays:
 rule delay_fits:
     input:
         delays=f"{TABLES}/delays.csv",
-        lib=LIB_DELAYS + LIB_SUMMARY,
+        lib=code("delay_fits"),
     output:
         report(
             f"{TABLES}/delay_fits.csv",
@@ -69,7 +69,7 @@ rule ssw:
         traces=all_trace_files,
         pulses=f"{TABLES}/pulses.csv",
         selection=selection_files,
-        lib=LIB_SSW,
+        lib=code("ssw"),
     output:
         f"{TABLES}/ssw.csv",
     log:
@@ -88,7 +88,7 @@ rule ssw:
 rule ssw_fits:
     input:
         ssw=f"{TABLES}/ssw.csv",
-        lib=LIB_SSW + LIB_SUMMARY,
+        lib=code("ssw_fits"),
     output:
         report(
             f"{TABLES}/ssw_fits.csv",

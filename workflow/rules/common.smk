@@ -6,13 +6,14 @@ from pathlib import Path
 
 import numpy as np
 
-from chain.config_checks import (
+from chain.pipeline.config import (
     VIRTUAL_SERIES,
     check_config,
     experiment_parts,
     virtual_experiment_settings,
 )
-from chain.config_checks import experiment_label as experiment_label_of
+from chain.pipeline.config import experiment_label as experiment_label_of
+from chain.pipeline.deps import script_sources
 
 check_config(config)
 
@@ -46,27 +47,21 @@ SPEEDS = [
 CONSERVATIVE = [name for name, m in MODELS.items() if m["eta_s"] == 0]
 TRACES_N = config["figures"]["traces_N"] or list(CHAINS)
 
-# The library that the jobs import: its source files are inputs of the rules that
-# use them, so editing the physics reruns the simulations, editing the analysis
-# reruns the tables, and editing figures.py only redraws.
-# (Not `import chain`: the name would shadow a Snakemake global.)
-LIB = Path(importlib.util.find_spec("chain").origin).parent
+# The code each job runs is an input of its rule: the script's local helpers and every
+# chain module it imports, read off the import statements (chain.pipeline.deps), so
+# editing the physics reruns the simulations, editing one figure's module redraws that
+# figure only, and a new import needs no edit here. Paths are relative to the working
+# directory, so a moved or copied checkout has nothing to do. PACKAGE_DIR is the
+# package the jobs import (a checkout's src/chain, or PYTHONPATH's copy); not found
+# with `import chain`: the name would shadow a Snakemake global.
+PACKAGE_DIR = Path(importlib.util.find_spec("chain").origin).parent
 
 
-def lib(*modules):
-    return [str(LIB / f"{module}.py") for module in modules]
-
-
-# Each list: the modules the rule's script calls and what they import.
-LIB_SIMULATE = lib("materials", "model", "integrator", "simulation", "theory", "traces")
-LIB_PULSES = lib("materials", "traces", "pulses")
-LIB_DELAYS = LIB_PULSES + lib("regression", "delays")
-LIB_SSW = LIB_DELAYS + lib("ssw")
-LIB_SUMMARY = lib("materials", "theory", "summary")
-LIB_FIGURES = LIB_SUMMARY + lib("traces", "figures")
-LIB_MEASURED = lib("materials", "acquisition", "traces", "measured")
-LIB_EXPERIMENT = LIB_SIMULATE + LIB_MEASURED + lib("experiment")
-LIB_SELECTION = lib("materials", "protocol")
+def code(script):
+    """Source files that workflow/scripts/<script>.py runs, besides itself."""
+    return script_sources(
+        Path(workflow.basedir) / "workflow" / "scripts" / f"{script}.py", PACKAGE_DIR
+    )
 
 
 # ---- trace sources -------------------------------------------------------------
@@ -125,7 +120,7 @@ def experiment_dataset_files():
 
 
 def virtual_settings(wildcards):
-    """chain.experiment.VirtualExperiment fields of one chain (plain values)."""
+    """chain.apparatus.virtual.VirtualExperiment fields of one chain (plain values)."""
     n = int(wildcards.N)
     return virtual_experiment_settings(config, n, CHAINS[n]["sensors"])
 

@@ -8,16 +8,16 @@
 #                                instead (their N and sensors from their metadata.yaml);
 #   experiment.source: none      nothing here runs, and Fig. 2 is not drawn.
 #
-# Then experiment_traces loads the datasets (chain.measured.load_dataset) into
+# Then experiment_traces loads the datasets (chain.apparatus.measured.load_dataset) into
 # experiment/<name>_N<N>_traces.csv, which the pulses rule analyses with the simulated
-# traces; selection applies the 5 % amplitude match (chain.protocol.select_shots) and
+# traces; selection applies the 5 % amplitude match (chain.analysis.selection.select_shots) and
 # writes experiment/selection.csv, which the delays and ssw rules use to drop rejected
 # collision shots. The parts, the label and the input functions are in common.smk.
 
 
 rule virtual_experiment:
     input:
-        LIB_EXPERIMENT,
+        code("virtual_experiment"),
     output:
         directory(f"{OUT}/experiment/raw/N{{N}}"),
     log:
@@ -38,7 +38,7 @@ rule virtual_experiment:
 rule experiment_traces:
     input:
         datasets=experiment_dataset_files(),
-        lib=LIB_MEASURED,
+        lib=code("experiment_traces"),
     output:
         experiment_trace_files(),
     log:
@@ -58,7 +58,7 @@ rule selection:
     input:
         pulses=f"{TABLES}/pulses.csv",
         traces=experiment_trace_files,
-        lib=LIB_SELECTION,
+        lib=code("selection"),
     output:
         report(
             f"{OUT}/experiment/selection.csv",

@@ -4,7 +4,7 @@
 
 rule fig1_setup:
     input:
-        LIB_FIGURES,
+        code("fig1_setup"),
     output:
         **figure_outputs("fig1_setup"),
     log:
@@ -28,7 +28,7 @@ rule fig2_experiment_traces:
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
         selection=selection_files,
-        lib=LIB_FIGURES,
+        lib=code("fig_traces"),
     output:
         **figure_outputs("fig2_experiment_traces"),
     log:
@@ -56,7 +56,7 @@ rule fig3_simulation_traces:
         ],
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
-        lib=LIB_FIGURES,
+        lib=code("fig_traces"),
     output:
         **figure_outputs("fig3_simulation_traces"),
     log:
@@ -79,7 +79,7 @@ rule fig4_delay_vs_force:
     input:
         delays=f"{TABLES}/delays.csv",
         fits=f"{TABLES}/delay_fits.csv",
-        lib=LIB_FIGURES,
+        lib=code("fig4_delay_vs_force"),
     output:
         **figure_outputs("fig4_delay_vs_force"),
     log:
@@ -101,7 +101,7 @@ rule fig5_ssw_vs_force:
     input:
         ssw=f"{TABLES}/ssw.csv",
         fits=f"{TABLES}/ssw_fits.csv",
-        lib=LIB_FIGURES,
+        lib=code("fig5_ssw_vs_force"),
     output:
         **figure_outputs("fig5_ssw_vs_force"),
     log:
@@ -119,7 +119,7 @@ rule fig5_ssw_vs_force:
 rule fig_parity_ssw_vs_N:
     input:
         fits=f"{TABLES}/ssw_fits.csv",
-        lib=LIB_FIGURES,
+        lib=code("fig_parity_ssw_vs_N"),
     output:
         **figure_outputs("fig_parity_ssw_vs_N"),
     log:

@@ -10,7 +10,7 @@ rule summary:
         ssw=f"{TABLES}/ssw.csv",
         selection=selection_files,
         runs=runs_files(),
-        lib=LIB_SUMMARY,
+        lib=code("summary"),
     output:
         json=f"{OUT}/summary.json",
         md=report(

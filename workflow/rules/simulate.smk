@@ -4,7 +4,7 @@
 
 rule simulate:
     input:
-        LIB_SIMULATE,
+        code("simulate"),
     output:
         traces=f"{OUT}/simulation/{{model}}_N{{N}}_traces.csv",
         runs=f"{OUT}/simulation/{{model}}_N{{N}}_runs.csv",

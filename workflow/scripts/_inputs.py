@@ -4,7 +4,7 @@ import pandas as pd
 
 
 def selection(snakemake):
-    """The shot-selection table (chain.protocol.select_shots), or None to keep all shots."""
+    """The shot-selection table (chain.analysis.selection.select_shots), or None (keep all)."""
     paths = list(snakemake.input.get("selection", []))
     if not paths:
         return None

@@ -1,11 +1,11 @@
-"""Crossing delay of every collision shot (chain.delays.delay_table)."""
+"""Crossing delay of every collision shot (chain.analysis.delays.delay_table)."""
 
 import pandas as pd
 from _inputs import selection
 from _logging import start
 
-from chain.delays import delay_table
-from chain.traces import write_csv_atomic
+from chain.analysis.delays import delay_table
+from chain.atomic import write_csv_atomic
 
 log = start(snakemake)
 table = delay_table(pd.read_csv(snakemake.input.pulses), selection=selection(snakemake))

@@ -1,8 +1,8 @@
-"""Every experiment dataset (measured-trace format) as a trace table (chain.measured)."""
+"""Every experiment dataset (measured-trace format) as a trace table (chain.apparatus.measured)."""
 
 from _logging import start
 
-from chain.measured import load_dataset
+from chain.apparatus.measured import load_dataset
 from chain.traces import write_traces
 
 log = start(snakemake)

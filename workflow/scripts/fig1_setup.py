@@ -1,10 +1,10 @@
-"""Fig. 1, the setup, drawn from the configured chains (chain.figures.fig1_setup)."""
+"""Fig. 1, the setup, drawn from the configured chains (chain.report.figures.fig1_setup)."""
 
 from pathlib import Path
 
 from _logging import start
 
-from chain.figures import fig1_setup, save_figure
+from chain.report.figures import fig1_setup, save_figure
 
 log = start(snakemake)
 p = snakemake.params

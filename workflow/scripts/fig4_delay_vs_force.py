@@ -1,19 +1,19 @@
-"""Fig. 4: |Delta| against F_m (chain.figures.fig4_delay_vs_force)."""
+"""Fig. 4: |Delta| against F_m (chain.report.figures.fig4_delay_vs_force)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.figures import fig4_delay_vs_force, save_figure
-from chain.summary import run_constants
+from chain.physics.theory import ballistic_constants
+from chain.report.figures import fig4_delay_vs_force, save_figure
 
 log = start(snakemake)
 p = snakemake.params
 fig = fig4_delay_vs_force(
     pd.read_csv(snakemake.input.delays),
     pd.read_csv(snakemake.input.fits),
-    constants=run_constants(p.material, p.radius_m),
+    constants=ballistic_constants(p.material, p.radius_m),
     estimator=p.estimator,
     experiment_label=p.experiment_label,
 )

@@ -1,11 +1,11 @@
-"""What-if figure: SSW slope against N, odd and even (chain.figures.fig_parity_ssw_vs_N)."""
+"""What-if figure: SSW slope against N, odd and even (chain.report.figures.fig_parity_ssw_vs_N)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.figures import fig_parity_ssw_vs_N, save_figure
+from chain.report.figures import fig_parity_ssw_vs_N, save_figure
 
 log = start(snakemake)
 fig = fig_parity_ssw_vs_N(

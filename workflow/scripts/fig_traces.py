@@ -6,7 +6,7 @@ import pandas as pd
 from _inputs import selection
 from _logging import start
 
-from chain.figures import fig2_experiment_traces, fig3_simulation_traces, save_figure
+from chain.report.figures import fig2_experiment_traces, fig3_simulation_traces, save_figure
 from chain.traces import read_traces
 
 log = start(snakemake)

@@ -1,10 +1,11 @@
-"""Fit the pulses of every trace file (chain.pulses.pulse_table)."""
+"""Fit the pulses of every trace file (chain.analysis.pulses.pulse_table)."""
 
 import pandas as pd
 from _logging import start
 
-from chain.pulses import pulse_table
-from chain.traces import read_traces, write_csv_atomic
+from chain.analysis.pulses import pulse_table
+from chain.atomic import write_csv_atomic
+from chain.traces import read_traces
 
 log = start(snakemake)
 estimators = tuple(snakemake.params.estimators)

@@ -1,10 +1,10 @@
-"""The paper's acceptance protocol on the experiment shots (chain.protocol.select_shots)."""
+"""The paper's acceptance protocol on the experiment shots (chain.analysis.selection)."""
 
 import pandas as pd
 from _logging import start
 
-from chain.protocol import select_shots
-from chain.traces import write_csv_atomic
+from chain.analysis.selection import select_shots
+from chain.atomic import write_csv_atomic
 
 log = start(snakemake)
 p = snakemake.params

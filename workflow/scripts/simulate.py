@@ -1,9 +1,12 @@
-"""Simulate one model on one chain for every launch speed (chain.simulate_shots)."""
+"""Simulate one model on one chain for every launch speed (chain.apparatus.shots)."""
 
 from _logging import start
 
-from chain import get_material, simulate_shots, uniform_chain
-from chain.traces import write_csv_atomic, write_traces
+from chain.apparatus.shots import simulate_shots
+from chain.atomic import write_csv_atomic
+from chain.physics.materials import get_material
+from chain.physics.model import uniform_chain
+from chain.traces import write_traces
 
 log = start(snakemake)
 p = snakemake.params

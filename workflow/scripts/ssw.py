@@ -1,11 +1,12 @@
-"""Secondary solitary waves behind every crossed pulse (chain.ssw.ssw_table)."""
+"""Secondary solitary waves behind every crossed pulse (chain.analysis.ssw.ssw_table)."""
 
 import pandas as pd
 from _inputs import selection
 from _logging import start
 
-from chain.ssw import ssw_table
-from chain.traces import read_traces, write_csv_atomic
+from chain.analysis.ssw import ssw_table
+from chain.atomic import write_csv_atomic
+from chain.traces import read_traces
 
 log = start(snakemake)
 pulses = pd.read_csv(snakemake.input.pulses)

@@ -1,10 +1,10 @@
-"""summary.json and summary.md: the run's numbers beside the paper's (chain.summary)."""
+"""summary.json and summary.md: the run's numbers beside the paper's (chain.report.summary)."""
 
 import pandas as pd
 from _inputs import selection
 from _logging import start
 
-from chain.summary import build_summary, write_summary
+from chain.report.summary import build_summary, write_summary
 
 log = start(snakemake)
 p = snakemake.params

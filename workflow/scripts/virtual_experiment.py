@@ -1,9 +1,9 @@
-"""The virtual experiment on one chain (chain.experiment.run_virtual_experiment): a
+"""The virtual experiment on one chain (chain.apparatus.virtual.run_virtual_experiment): a
 model of the apparatus writing a dataset in the measured-trace format (not data)."""
 
 from _logging import start
 
-from chain.experiment import VirtualExperiment, run_virtual_experiment
+from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 
 log = start(snakemake)
 settings = VirtualExperiment.from_dict(snakemake.params.settings)

@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from chain.acquisition import volts_to_newtons
+from chain.apparatus.acquisition import volts_to_newtons
 from chain.atomic import write_text_atomic
 from chain.traces import KINDS, META_COLUMNS, sensor_column, validate_traces
 

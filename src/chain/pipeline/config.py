@@ -38,20 +38,20 @@ the record when it is shorter; that is not an error.
 
 from __future__ import annotations
 
-import math
 import os
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from chain.materials import MATERIALS, ParameterError, get_material
-from chain.theory import force_from_bead_velocity, nesterenko_speed_from_force, pulse_half_width
-
-#: V_m / V0 of the solitary wave formed when bead 1 of a free chain is launched at V0
-#: (0.47 measured: F_m = 1030 N at 1 m/s in the paper's chains); a little lower, so that
-#: the estimated wave is, if anything, too slow.
-LAUNCH_VELOCITY_RATIO = 0.45
+from chain.errors import ParameterError
+from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
+from chain.physics.materials import MATERIALS, get_material
+from chain.physics.theory import (
+    LAUNCH_VELOCITY_RATIO,
+    force_from_bead_velocity,
+    pulse_passing_time,
+)
 
 #: The duration must be this many times the time the slowest pulse needs to pass the
 #: far sensor (see the module docstring).
@@ -60,13 +60,7 @@ DURATION_MARGIN = 1.2
 #: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
 SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
-#: Name of the virtual experiment's series when experiment.name is null.
-VIRTUAL_SERIES = "virtual"
-
-#: Label of the virtual experiment's rows in figures and summary (not data).
-VIRTUAL_LABEL = "virtual experiment (model)"
-
-#: Config key of experiment.virtual -> field of chain.experiment.VirtualExperiment.
+#: Config key of experiment.virtual -> field of chain.apparatus.virtual.VirtualExperiment.
 VIRTUAL_FIELDS = {
     "eta_s": "eta",
     "drag_rate_per_s": "drag_rate",
@@ -112,55 +106,6 @@ def _fail(path, message: str):
     raise ConfigError(f"config key {key_name(path)!r}: {message}")
 
 
-def pulse_passing_time(
-    material: str,
-    radius_m: float,
-    n_beads: int,
-    sensors: Sequence[int],
-    v0_m_s: float,
-    mass_ratio: float = 1.0,
-) -> dict[str, float]:
-    """When the slowest pulse has passed the far sensor (the duration check).
-
-    Parameters
-    ----------
-    material : str
-        Bead material name.
-    radius_m : float
-        Bead radius R, m.
-    n_beads : int
-        Number of beads N.
-    sensors : sequence of int
-        Sensor beads [S1, S2].
-    v0_m_s : float
-        Launch speed of the slowest wave, m/s (bead 1's, or the striker's).
-    mass_ratio : float
-        Launcher mass over bead mass (1 when bead 1 itself is launched).
-
-    Returns
-    -------
-    dict
-        ``force_N`` (estimated incident F_m), ``speed_m_s`` (Eq. 5), ``tau_s`` (Eq. 4),
-        ``distance_m`` (launching end to the far sensor), ``bead`` (that sensor) and
-        ``time_s`` = distance / speed + (pi/2) tau.
-    """
-    beads = get_material(material)
-    s1, s2 = sensors[0], sensors[-1]
-    bead, beads_away = (s2, s2 - 1) if s2 - 1 >= n_beads - s1 else (s1, n_beads - s1)
-    distance = 2.0 * radius_m * beads_away
-    force = force_from_bead_velocity(LAUNCH_VELOCITY_RATIO * mass_ratio * v0_m_s, beads, radius_m)
-    speed = nesterenko_speed_from_force(force, beads, radius_m)
-    tau = pulse_half_width(force, beads, radius_m)
-    return {
-        "force_N": force,
-        "speed_m_s": speed,
-        "tau_s": tau,
-        "distance_m": distance,
-        "bead": bead,
-        "time_s": distance / speed + 0.5 * math.pi * tau,
-    }
-
-
 def _check_duration(path, duration, config, v0, mass_ratio, what) -> None:
     worst = None
     for entry in config["chains"]:
@@ -183,7 +128,7 @@ def _check_duration(path, duration, config, v0, mass_ratio, what) -> None:
 
 
 def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence[int]) -> dict:
-    """The :class:`chain.experiment.VirtualExperiment` fields for one chain of a config.
+    """The :class:`chain.apparatus.virtual.VirtualExperiment` fields for one chain of a config.
 
     Material and radius are the run's, the striker radius ``setup.striker_radius_m``,
     the seed the top-level seed + N (so that the chains' shots differ), the rest
@@ -256,8 +201,8 @@ def _check_experiment(config: Mapping) -> None:
             f"{step:g} s is longer than sampling_interval_s = {sampling:g} s; allowed: "
             "<= the sampling interval, or null",
         )
-    # Imported here: chain.experiment pulls in the simulation core.
-    from chain.experiment import VirtualExperiment
+    # Imported here: chain.apparatus.virtual pulls in the simulation core.
+    from chain.apparatus.virtual import VirtualExperiment
 
     settings = None
     for entry in config["chains"]:
@@ -462,8 +407,8 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
         (the loader's message, with file and line), its name is not usable in file
         names, or two datasets give the same name and N.
     """
-    # Imported here: chain.measured reads files; check_config does not need it.
-    from chain.measured import MeasuredDataError, read_metadata
+    # Imported here: chain.apparatus.measured reads files; check_config does not need it.
+    from chain.apparatus.measured import MeasuredDataError, read_metadata
 
     experiment = config.get("experiment", {})
     source = experiment.get("source", "none")

@@ -31,7 +31,7 @@ import numpy as np
 from scipy.optimize import curve_fit
 from scipy.stats import linregress
 
-from chain.materials import ParameterError
+from chain.errors import ParameterError
 
 #: Fewest points for a one-coefficient fit (one degree of freedom left for its error).
 MIN_POINTS_ONE_PARAMETER = 2

@@ -14,8 +14,8 @@ import math
 import os
 from pathlib import Path
 
-from chain.delays import DELAY_FIT_COLUMNS
-from chain.ssw import SSW_FIT_COLUMNS
+from chain.analysis.delays import DELAY_FIT_COLUMNS
+from chain.analysis.ssw import SSW_FIT_COLUMNS
 
 #: Files of the results contract (design.md), relative to results/<run_name>/.
 CONTRACT_FIGURES = (

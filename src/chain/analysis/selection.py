@@ -5,7 +5,7 @@ greater than 5 %, it is considered that solitary waves have crossed at the middl
 chain ... Data for which this condition is not fulfilled are not retained."
 
 :func:`select_shots` applies it to the rows of ``pulses.csv``
-(:func:`chain.pulses.pulse_table`): a collision shot is kept when the incident
+(:func:`chain.analysis.pulses.pulse_table`): a collision shot is kept when the incident
 amplitudes F_L (LSTW at S1) and F_R (RSTW at S2) satisfy
 
     mismatch = |F_L - F_R| / ((F_L + F_R) / 2) <= tolerance,
@@ -21,7 +21,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from chain.materials import ParameterError
+from chain.analysis.rows import is_ok
+from chain.errors import ParameterError
 
 #: The paper's amplitude-match tolerance (5 %).
 DEFAULT_TOLERANCE = 0.05
@@ -41,7 +42,9 @@ SELECTION_COLUMNS = (
     "reason",
 )
 
-_KEY = ["source", "model", "N", "shot"]
+#: Columns naming a series: the shot key is these plus ``shot``.
+GROUP = ["source", "model", "N"]
+_KEY = [*GROUP, "shot"]
 _PULSE_COLUMNS = (
     "source",
     "model",
@@ -82,7 +85,7 @@ def select_shots(
     Parameters
     ----------
     pulses : DataFrame
-        Rows of ``pulses.csv`` (columns of :func:`chain.pulses.pulse_table`; needed:
+        Rows of ``pulses.csv`` (columns of :func:`chain.analysis.pulses.pulse_table`; needed:
         source, model, N, shot, kind, amplitude, sensor, role, estimator, F_m_N, ok,
         and reason when present).
     tolerance : float
@@ -140,7 +143,7 @@ def select_shots(
                 }
             )
     selection = pd.DataFrame(rows, columns=SELECTION_COLUMNS)
-    selection["kept"] = selection["kept"].astype(bool)
+    selection["kept"] = is_ok(selection, "kept")
     return selection.sort_values(_KEY, kind="stable").reset_index(drop=True)
 
 
@@ -209,3 +212,60 @@ def _judge_reference(group: pd.DataFrame) -> dict:
         "kept": True,
         "reason": "kept: reference pulse fitted at " + " and ".join(sensors),
     }
+
+
+def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
+    """Drop the rows of collision shots whose ``kept`` is False in ``selection``.
+
+    Shots are matched on ``shot`` and on whichever of ``source, model, N`` both tables
+    have. Reference shots and shots absent from ``selection`` are kept.
+
+    Parameters
+    ----------
+    table : DataFrame
+        Rows with a ``shot`` column (and ``kind`` if it holds reference shots).
+    selection : DataFrame or None
+        ``chain.analysis.selection.select_shots`` output (``shot``, ``kept``, ...); None keeps all.
+    """
+    if selection is None:
+        return table
+    keys = [c for c in (*GROUP, "shot") if c in table.columns and c in selection.columns]
+    dropped = selection.loc[~is_ok(selection, "kept"), keys].drop_duplicates()
+    if dropped.empty:
+        return table
+    marker = table[keys].merge(dropped.assign(_drop=True), on=keys, how="left")["_drop"]
+    drop = marker.fillna(False).to_numpy(dtype=bool)
+    if "kind" in table.columns:
+        drop &= (table["kind"] == "collision").to_numpy()
+    return table.loc[~drop]
+
+
+def selection_counts(selection: pd.DataFrame | None) -> list[dict]:
+    """Kept and rejected shots of the acceptance protocol per series, chain and kind.
+
+    Parameters
+    ----------
+    selection : DataFrame or None
+        ``experiment/selection.csv`` (:func:`chain.analysis.selection.select_shots`).
+
+    Returns
+    -------
+    list of dict
+        ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
+    """
+    if selection is None or not len(selection):
+        return []
+    kept = is_ok(selection, "kept")
+    rows = []
+    for (model, n, kind), group in selection.groupby(["model", "N", "kind"], sort=True):
+        k = int(kept.loc[group.index].sum())
+        rows.append(
+            {
+                "model": str(model),
+                "N": int(n),
+                "kind": str(kind),
+                "kept": k,
+                "rejected": len(group) - k,
+            }
+        )
+    return rows

@@ -7,11 +7,13 @@ SI units throughout; constants named ``*_us_N16`` are in microseconds N^(1/6).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.special import gamma
 
-from chain.materials import Material, require_positive
+from chain.errors import require_positive
+from chain.physics.materials import Material, contact_stiffness, get_material, sphere_mass
 
 #: Contact-time constant of a Hertz collision, t_c = HERTZ_TIME_CONSTANT * delta_max / v_rel.
 #: Exactly 2 * integral_0^1 dx / sqrt(1 - x^(5/2)) = 2 sqrt(pi) Gamma(7/5) / Gamma(9/10)
@@ -23,6 +25,12 @@ PAPER_TIME_CONSTANT = 2.94
 
 #: The numerical prefactor printed in the second line of Eq. 6.
 PAPER_CBAL_PREFACTOR = 0.7612
+
+
+#: V_m / V0 of the solitary wave formed when bead 1 of a free chain is launched at V0
+#: (0.47 measured: F_m = 1030 N at 1 m/s in the paper's chains); a little lower, so that
+#: the estimated wave is, if anything, too slow.
+LAUNCH_VELOCITY_RATIO = 0.45
 
 
 def hertz_max_overlap(mass_a: float, mass_b: float, kappa: float, relative_speed: float) -> float:
@@ -299,3 +307,78 @@ def _reduced_mass(mass_a: float, mass_b: float) -> float:
     if math.isinf(mass_b):
         return mass_a
     return mass_a * mass_b / (mass_a + mass_b)
+
+
+def ballistic_constants(material: str, radius_m: float) -> dict[str, float]:
+    """Contact stiffness, bead mass and the two ballistic delay constants of a run.
+
+    Parameters
+    ----------
+    material : str
+        Bead material name (:data:`chain.physics.materials.MATERIALS`).
+    radius_m : float
+        Bead radius, m.
+
+    Returns
+    -------
+    dict
+        ``kappa_N_m1_5`` (N/m^1.5), ``bead_mass_kg``, ``C_bal_paper_us_N16`` (Eq. 6 as
+        printed) and ``C_bal_exact_us_N16`` (the same argument with the exact Hertz
+        contact time of two free beads), in us N^(1/6).
+    """
+    beads = get_material(material)
+    return {
+        "kappa_N_m1_5": contact_stiffness(beads, radius_m, beads, radius_m),
+        "bead_mass_kg": sphere_mass(beads, radius_m),
+        "C_bal_paper_us_N16": ballistic_delay_constant_paper(beads, radius_m) * 1e6,
+        "C_bal_exact_us_N16": ballistic_delay_constant_exact(beads, radius_m) * 1e6,
+    }
+
+
+def pulse_passing_time(
+    material: str,
+    radius_m: float,
+    n_beads: int,
+    sensors: Sequence[int],
+    v0_m_s: float,
+    mass_ratio: float = 1.0,
+) -> dict[str, float]:
+    """When the slowest pulse has passed the far sensor (the duration check).
+
+    Parameters
+    ----------
+    material : str
+        Bead material name.
+    radius_m : float
+        Bead radius R, m.
+    n_beads : int
+        Number of beads N.
+    sensors : sequence of int
+        Sensor beads [S1, S2].
+    v0_m_s : float
+        Launch speed of the slowest wave, m/s (bead 1's, or the striker's).
+    mass_ratio : float
+        Launcher mass over bead mass (1 when bead 1 itself is launched).
+
+    Returns
+    -------
+    dict
+        ``force_N`` (estimated incident F_m), ``speed_m_s`` (Eq. 5), ``tau_s`` (Eq. 4),
+        ``distance_m`` (launching end to the far sensor), ``bead`` (that sensor) and
+        ``time_s`` = distance / speed + (pi/2) tau.
+    """
+    beads = get_material(material)
+    s1, s2 = sensors[0], sensors[-1]
+    bead, beads_away = (s2, s2 - 1) if s2 - 1 >= n_beads - s1 else (s1, n_beads - s1)
+    distance = 2.0 * radius_m * beads_away
+    force = force_from_bead_velocity(LAUNCH_VELOCITY_RATIO * mass_ratio * v0_m_s, beads, radius_m)
+    speed = nesterenko_speed_from_force(force, beads, radius_m)
+    tau = pulse_half_width(force, beads, radius_m)
+    return {
+        "force_N": force,
+        "speed_m_s": speed,
+        "tau_s": tau,
+        "distance_m": distance,
+        "bead": bead,
+        "time_s": distance / speed + 0.5 * math.pi * tau,
+    }

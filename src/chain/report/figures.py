@@ -37,8 +37,9 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, FancyArrowPatch, FancyBboxPatch, Rectangle
 
+from chain.analysis.rows import is_ok, usable_rows
 from chain.atomic import atomic_output
-from chain.summary import PAPER, usable_rows
+from chain.report.paper import PAPER
 from chain.traces import sensor_beads, sensor_column
 
 #: Resolution of the PNG files, dots per inch.
@@ -82,7 +83,7 @@ REFERENCE_COLOR = "black"
 
 MICRO = 1e6
 
-#: SSW measurement drawn in Fig. 3 and Fig. 5 (chain.ssw: ``residual`` or ``peak``).
+#: SSW measurement drawn in Fig. 3 and Fig. 5 (chain.analysis.ssw: ``residual`` or ``peak``).
 SSW_METHOD = "residual"
 
 
@@ -177,12 +178,6 @@ def _label_source(source: str, experiment_label: str) -> str:
 
 def _is_pooled(column: pd.Series) -> pd.Series:
     return column.astype(str) == "pooled"
-
-
-def _as_bool(column: pd.Series) -> pd.Series:
-    if column.dtype == bool:
-        return column
-    return column.astype(str).str.lower().isin(("true", "1"))
 
 
 def _plain_log_ticks(axis) -> None:
@@ -409,7 +404,7 @@ def fig2_experiment_traces(
     Parameters
     ----------
     selection : DataFrame, optional
-        ``experiment/selection.csv`` (:func:`chain.protocol.select_shots`): the
+        ``experiment/selection.csv`` (:func:`chain.analysis.selection.select_shots`): the
         collision shot drawn is the first one the acceptance protocol kept, from the
         amplitudes that have one. None: the first collision shot.
     """
@@ -521,7 +516,7 @@ def _pick_amplitude(table, pulses, source, n, estimator, target_force, index, ke
             & (pulses["sensor"] == "S1")
             & (pulses["role"] == "incident")
             & (pulses["estimator"] == estimator)
-            & _as_bool(pulses["ok"])
+            & is_ok(pulses)
         ]
         if len(rows):
             forces = rows.groupby("amplitude")["F_m_N"].mean()
@@ -546,7 +541,7 @@ def _pulse_times(pulses, shot_meta, sensor, estimator):
         & (pulses["shot"] == shot_meta["shot"])
         & (pulses["sensor"] == sensor)
         & (pulses["estimator"] == estimator)
-        & _as_bool(pulses["ok"])
+        & is_ok(pulses)
     ]
     return {row.role: (row.T_s, row.tau_s, row.F_m_N) for row in rows.itertuples()}
 
@@ -670,7 +665,7 @@ def _kept_shots(selection, table) -> set | None:
     rows = selection[
         (selection["model"] == meta["model"])
         & (selection["N"].astype(str) == str(meta["N"]))
-        & _as_bool(selection["kept"])
+        & is_ok(selection, "kept")
     ]
     if "source" in selection.columns:
         rows = rows[rows["source"] == meta["source"]]
@@ -770,7 +765,7 @@ def _inset_bounds(ax) -> list[float]:
 def _draw_ssw_inset(ax, time, force, split, times, meta, sensor, ssw, style, template):
     """Zoom on the crossed pulse's trailing edge, where the secondary solitary wave (SSW)
     rides at the paper's sensor positions: the crossed pulse, the reference pulse
-    shifted and scaled onto it (peak on peak), and the SSW of :mod:`chain.ssw` marked
+    shifted and scaled onto it (peak on peak), and the SSW of :mod:`chain.analysis.ssw` marked
     at its time with its amplitude."""
     crossed_time, crossed_force = time[split:], force[split:]
     i_peak = int(np.argmax(crossed_force))
@@ -788,7 +783,7 @@ def _draw_ssw_inset(ax, time, force, split, times, meta, sensor, ssw, style, tem
             & (ssw["N"].astype(str) == str(meta["N"]))
             & (ssw["shot"] == meta["shot"])
             & (ssw["sensor"] == sensor)
-            & _as_bool(ssw["ok"])
+            & is_ok(ssw)
         ]
         if len(rows) and np.isfinite(rows["ssw_time_us"].iloc[0]):
             marker = (float(rows["ssw_time_us"].iloc[0]), float(rows["ssw_N"].iloc[0]))
@@ -861,7 +856,7 @@ def fig4_delay_vs_force(
         ``delay_fits.csv``.
     constants : mapping, optional
         ``C_bal_paper_us_N16`` and ``C_bal_exact_us_N16`` of this run's beads
-        (:func:`chain.summary.run_constants`).
+        (:func:`chain.physics.theory.ballistic_constants`).
     estimator : str
         Estimator drawn.
     experiment_label : str

@@ -1,4 +1,4 @@
-"""Fixed-step classical RK4 for a :class:`~chain.model.ChainModel` (the paper's method).
+"""Fixed-step classical RK4 for a :class:`~chain.physics.model.ChainModel` (the paper's method).
 
 The private numba kernels take flat arrays and write into preallocated outputs;
 :func:`integrate` checks its inputs, allocates, and turns a failed run into an
@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from chain.materials import ParameterError, require_positive
-from chain.model import HERTZ, SPRING, ChainModel
+from chain.errors import ParameterError, require_positive
+from chain.physics.model import HERTZ, SPRING, ChainModel
 
 #: Status codes written by the kernel.
 _OK = 0
@@ -290,7 +290,7 @@ def _integrate_batch(
 
 @dataclass(frozen=True)
 class RawTrajectory:
-    """Particle-level output of :func:`integrate`; :mod:`chain.simulation` maps it to beads.
+    """Particle-level output of :func:`integrate`; :mod:`chain.physics.simulation` maps it to beads.
 
     Attributes
     ----------

@@ -1,7 +1,7 @@
 """The run's headline numbers beside the paper's: ``summary.json`` and ``summary.md``.
 
 Every number is computed from the run's tables and the closed forms of
-:mod:`chain.theory`, except the paper's own values in :data:`PAPER`, quoted as
+:mod:`chain.physics.theory`, except the paper's own values in :data:`PAPER`, quoted as
 printed. :func:`build_summary` gathers them into a JSON-ready dict,
 :func:`summary_markdown` renders the side-by-side table, and :func:`write_summary`
 writes both atomically with sorted keys and fixed float formatting.
@@ -18,168 +18,20 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 import pandas as pd
 
+from chain.analysis.rows import flag_counts, is_ok
+from chain.analysis.selection import selection_counts
 from chain.atomic import write_text_atomic
-from chain.materials import contact_stiffness, get_material, sphere_mass
-from chain.theory import (
+from chain.physics.theory import (
     HERTZ_TIME_CONSTANT,
     PAPER_TIME_CONSTANT,
-    ballistic_delay_constant_exact,
-    ballistic_delay_constant_paper,
+    ballistic_constants,
 )
-
-#: The paper's numbers, as printed (Fig. 4 caption and Eq. 6), us N^(1/6).
-PAPER = {"C_exp_us_N16": 45.9, "C_exp_err_us_N16": 0.5, "C_bal_us_N16": 49.74}
-
-#: Relative energy variation the paper's integration keeps to (Sec. II).
-PAPER_ENERGY_DRIFT = 1e-9
+from chain.report.paper import PAPER, PAPER_ENERGY_DRIFT
 
 #: Significant digits of floats in summary.json.
 JSON_DIGITS = 10
 
 log = logging.getLogger(__name__)
-
-
-def _ok(table: pd.DataFrame) -> pd.Series:
-    """The ``ok`` column as booleans (True/False or their text); missing or NaN is False."""
-    if "ok" not in table.columns:
-        return pd.Series(True, index=table.index)
-    column = table["ok"]
-    if column.dtype == bool:
-        return column
-    return column.astype(str).str.strip().str.lower().isin(("true", "1", "1.0"))
-
-
-def usable_rows(
-    table: pd.DataFrame, columns: Iterable[str], what: str = "rows", *, positive: bool = False
-) -> pd.DataFrame:
-    """The rows fit to draw or fit: ``ok`` True and finite (and > 0 if ``positive``) in
-    ``columns``; how many were left out, and why, goes to the log (INFO).
-
-    A flagged row (``ok`` False, with its ``reason``) or a NaN never passes quietly into
-    a figure or a fit.
-
-    Parameters
-    ----------
-    table : DataFrame
-        A results table with an ``ok`` column (``delays.csv``, ``ssw.csv``, ...).
-    columns : iterable of str
-        Value columns that must be finite.
-    what : str
-        Name of the rows in the log message.
-    positive : bool
-        Also require values > 0 (for a log axis).
-    """
-    columns = list(columns)
-    ok = _ok(table)
-    values = table[columns].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
-    finite = np.isfinite(values).all(axis=1) if columns else np.ones(len(table), bool)
-    good = ok.to_numpy() & finite
-    nonpositive = np.zeros(len(table), bool)
-    if positive and columns:
-        nonpositive = good & ~(values > 0).all(axis=1)
-        good &= ~nonpositive
-    left_out = len(table) - int(good.sum())
-    if left_out:
-        log.info(
-            "%s: %d of %d left out (%d flagged ok = False, %d ok but NaN/inf in %s%s)",
-            what,
-            left_out,
-            len(table),
-            int((~ok).sum()),
-            int((ok.to_numpy() & ~finite).sum()),
-            columns,
-            f", {int(nonpositive.sum())} <= 0 on a log axis" if positive else "",
-        )
-    return table[good]
-
-
-def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict:
-    """Rows and flagged rows of a results table, per source.
-
-    Parameters
-    ----------
-    table : DataFrame or None
-        A table with ``source`` and ``ok`` columns.
-    columns : iterable of str
-        Value columns: an ``ok`` row with a NaN there counts as ``nan``.
-
-    Returns
-    -------
-    dict
-        ``{source: {"rows": n, "flagged": n_ok_false, "nan": n_ok_but_nan}}``.
-    """
-    if table is None or not len(table):
-        return {}
-    columns = list(columns)
-    ok = _ok(table)
-    counts = {}
-    for source, group in table.groupby("source", sort=True):
-        good = ok.loc[group.index]
-        values = group[columns].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
-        nan = good.to_numpy() & ~np.isfinite(values).all(axis=1) if columns else 0
-        counts[str(source)] = {
-            "rows": len(group),
-            "flagged": int((~good).sum()),
-            "nan": int(np.sum(nan)),
-        }
-    return counts
-
-
-def selection_counts(selection: pd.DataFrame | None) -> list[dict]:
-    """Kept and rejected shots of the acceptance protocol per series, chain and kind.
-
-    Parameters
-    ----------
-    selection : DataFrame or None
-        ``experiment/selection.csv`` (:func:`chain.protocol.select_shots`).
-
-    Returns
-    -------
-    list of dict
-        ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
-    """
-    if selection is None or not len(selection):
-        return []
-    kept = _ok(selection.rename(columns={"kept": "ok"})[["ok"]])
-    rows = []
-    for (model, n, kind), group in selection.groupby(["model", "N", "kind"], sort=True):
-        k = int(kept.loc[group.index].sum())
-        rows.append(
-            {
-                "model": str(model),
-                "N": int(n),
-                "kind": str(kind),
-                "kept": k,
-                "rejected": len(group) - k,
-            }
-        )
-    return rows
-
-
-def run_constants(material: str, radius_m: float) -> dict[str, float]:
-    """Contact stiffness, bead mass and the two ballistic delay constants of a run.
-
-    Parameters
-    ----------
-    material : str
-        Bead material name (:data:`chain.materials.MATERIALS`).
-    radius_m : float
-        Bead radius, m.
-
-    Returns
-    -------
-    dict
-        ``kappa_N_m1_5`` (N/m^1.5), ``bead_mass_kg``, ``C_bal_paper_us_N16`` (Eq. 6 as
-        printed) and ``C_bal_exact_us_N16`` (the same argument with the exact Hertz
-        contact time of two free beads), in us N^(1/6).
-    """
-    beads = get_material(material)
-    return {
-        "kappa_N_m1_5": contact_stiffness(beads, radius_m, beads, radius_m),
-        "bead_mass_kg": sphere_mass(beads, radius_m),
-        "C_bal_paper_us_N16": ballistic_delay_constant_paper(beads, radius_m) * 1e6,
-        "C_bal_exact_us_N16": ballistic_delay_constant_exact(beads, radius_m) * 1e6,
-    }
 
 
 def _number(value):
@@ -294,7 +146,7 @@ def build_summary(
             "main_estimator": main_estimator,
             "experiment_label": experiment_label,
             "conservative_models": sorted(conservative),
-            "constants": run_constants(material, radius_m),
+            "constants": ballistic_constants(material, radius_m),
             "paper": dict(PAPER),
             "max_energy_drift": max_drift,
             "energy_drift_by_model": drift_by_model,
@@ -333,7 +185,7 @@ def attenuation_rows(pulses: pd.DataFrame | None, estimator: str = "fit_full") -
         (pulses["source"] == "simulation")
         & (pulses["kind"] == "reference")
         & (pulses["estimator"] == estimator)
-        & _ok(pulses)
+        & is_ok(pulses)
     ]
     out = []
     for (model, n_beads), group in rows.groupby(["model", "N"], sort=True):
@@ -428,7 +280,7 @@ def summary_markdown(summary: Mapping) -> str:
             "same ballistic argument with the exact two-bead contact time: Eq. 6 uses the "
             "mass m (a bead against an immovable body) where two free beads have reduced "
             f"mass m/2, and rounds 2.9432 to 2.94; ratio {exact_ratio:.3f} "
-            "(see chain.theory.hertz_contact_time)",
+            "(see chain.physics.theory.hertz_contact_time)",
         ),
         (
             "C_exp, experiment fit (µs N^1/6)",

@@ -9,31 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-
-class ParameterError(ValueError):
-    """An input value is outside its physical range; the message names the parameter."""
-
-
-def require_positive(name: str, value: float) -> float:
-    """Return ``value`` as a float, or raise :class:`ParameterError` naming ``name``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number) or number <= 0.0:
-        raise ParameterError(f"{name} must be a positive finite number, got {value!r}")
-    return number
-
-
-def require_nonnegative(name: str, value: float) -> float:
-    """Return ``value`` as a float, or raise :class:`ParameterError` naming ``name``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number) or number < 0.0:
-        raise ParameterError(f"{name} must be a non-negative finite number, got {value!r}")
-    return number
+from chain.errors import ParameterError, require_positive
 
 
 @dataclass(frozen=True)

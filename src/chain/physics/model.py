@@ -24,15 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from chain.materials import (
-    STEEL_100C6,
-    Material,
-    ParameterError,
-    contact_stiffness,
-    require_nonnegative,
-    require_positive,
-    sphere_mass,
-)
+from chain.errors import ParameterError, require_nonnegative, require_positive
+from chain.physics.materials import STEEL_100C6, Material, contact_stiffness, sphere_mass
 
 #: Link kinds.
 HERTZ = 0

@@ -10,7 +10,7 @@ data whose truth is known:
   beads 1 and N, launched towards the chain at the impact speed (or sqrt(2 g h) for a
   drop height h);
 * split sensor beads (two halves joined by the sensor stiffness) read as the sensor
-  spring force (``readout="sensor"`` of :mod:`chain.simulation`);
+  spring force (``readout="sensor"`` of :mod:`chain.physics.simulation`);
 * optional track friction, a linear drag F = -m gamma v on every particle (gamma =
   ``drag_rate``, 1/s; 0 by default). It is the simplest momentum-losing term and is
   configurable; the paper estimates track friction to be of the order of the viscous
@@ -21,13 +21,13 @@ data whose truth is known:
   one (an initial gap speed x delay between striker and end bead; a negative delay puts
   the gap on the left striker instead); the digitiser's sampling phase is uniform in
   one interval;
-* acquisition (:mod:`chain.acquisition`): additive Gaussian noise, sampling every
+* acquisition (:mod:`chain.apparatus.acquisition`): additive Gaussian noise, sampling every
   ``sampling_interval_s``, volts through the sensitivity, ADC quantisation.
 
 Each nominal amplitude gets ``collision_shots`` shots with both strikers and
 ``reference_shots`` with the left striker alone (the right striker absent). The shots
-are written in the measured-trace format (:mod:`chain.measured`), so
-:func:`chain.measured.load_dataset` reads them like a lab's files; a
+are written in the measured-trace format (:mod:`chain.apparatus.measured`), so
+:func:`chain.apparatus.measured.load_dataset` reads them like a lab's files; a
 ``virtual_truth.csv`` beside them records what each shot really was.
 """
 
@@ -47,22 +47,14 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from chain.acquisition import (
+from chain.apparatus.acquisition import (
     PCB_200B02_SENSITIVITY_MV_PER_N,
     add_noise,
     newtons_to_volts,
     quantise,
     resample,
 )
-from chain.atomic import ordinary_mode, write_text_atomic
-from chain.materials import (
-    Material,
-    ParameterError,
-    get_material,
-    require_nonnegative,
-    require_positive,
-)
-from chain.measured import (
+from chain.apparatus.measured import (
     FORMAT_NAME,
     METADATA_FILE,
     impact_speed_from_drop_height,
@@ -70,11 +62,17 @@ from chain.measured import (
     write_metadata,
     write_shot_csv,
 )
-from chain.model import PAPER_BEAD_RADIUS, PAPER_STRIKER_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
-from chain.simulation import default_time_step, simulate
-
-#: Label written in every description field of a virtual dataset.
-VIRTUAL_LABEL = "virtual experiment (model)"
+from chain.atomic import ordinary_mode, replace_folder, write_text_atomic
+from chain.errors import ParameterError, require_nonnegative, require_positive
+from chain.labels import VIRTUAL_LABEL
+from chain.physics.materials import Material, get_material
+from chain.physics.model import (
+    PAPER_BEAD_RADIUS,
+    PAPER_STRIKER_RADIUS,
+    PCB_200B02_STIFFNESS,
+    uniform_chain,
+)
+from chain.physics.simulation import default_time_step, simulate
 
 #: File beside the shots recording the true launch of each shot (ignored by the loader).
 TRUTH_FILE = "virtual_truth.csv"
@@ -84,7 +82,7 @@ TRUTH_FILE = "virtual_truth.csv"
 DEFAULT_IMPACT_SPEEDS_M_S = (0.4, 0.6, 0.8, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
 
 #: The virtual experiment integrates with this many times the conservative default step
-#: of :func:`chain.simulation.default_time_step` (which aims at a 1e-9 energy drift).
+#: of :func:`chain.physics.simulation.default_time_step` (which aims at a 1e-9 energy drift).
 #: At 8x the sensor forces change by ~1e-6 relative (checked against 1x), far below
 #: the sensor noise and the ADC step, and a paper-sized run takes seconds.
 TIME_STEP_COARSENING = 8
@@ -107,7 +105,7 @@ class VirtualExperiment:
     sensor_beads : tuple of int
         Split sensor beads, S1 first (paper: (9, 17) for N = 25, (10, 17) for N = 26).
     material : str or Material
-        Bead and striker material (name from :data:`chain.materials.MATERIALS`).
+        Bead and striker material (name from :data:`chain.physics.materials.MATERIALS`).
     radius : float
         Bead radius, m (paper: 13e-3).
     striker_radius : float
@@ -278,7 +276,7 @@ class VirtualExperiment:
 
     @property
     def material_object(self) -> Material:
-        """The bead and striker :class:`~chain.materials.Material`."""
+        """The bead and striker :class:`~chain.physics.materials.Material`."""
         return self.material if isinstance(self.material, Material) else get_material(self.material)
 
     @property
@@ -523,7 +521,7 @@ def run_virtual_experiment(
         text = truth.to_csv(index=False, float_format="%.10g", lineterminator="\n")
         write_text_atomic(text, staging / TRUTH_FILE)
         write_metadata(staging, _metadata(settings, plan, dataset_name))
-        _replace_folder(staging, out)
+        replace_folder(staging, out)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
@@ -556,7 +554,7 @@ def _metadata(settings: VirtualExperiment, plan: pd.DataFrame, dataset_name: str
         apparatus["material"] = _plain(asdict(settings.material))
     apparatus = {
         "model": VIRTUAL_LABEL,
-        "generator": "chain.experiment.run_virtual_experiment",
+        "generator": "chain.apparatus.virtual.run_virtual_experiment",
         **apparatus,
     }
     sensitivities = settings.sensitivities
@@ -596,16 +594,3 @@ def _plain(value):
     if isinstance(value, np.generic):
         return value.item()
     return value
-
-
-def _replace_folder(staging: Path, out: Path) -> None:
-    """Move ``staging`` to ``out``; an existing ``out`` (a dataset) is swapped out first
-    and deleted, so a reader sees the old dataset or the new one, never a mixture."""
-    if not out.exists():
-        os.replace(staging, out)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
-    old.rmdir()
-    os.replace(out, old)
-    os.replace(staging, out)
-    shutil.rmtree(old, ignore_errors=True)

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from chain.materials import ParameterError, require_nonnegative, require_positive
+from chain.errors import ParameterError, require_nonnegative, require_positive
 
 #: Sensitivity of the paper's sensor, PCB 200B02 (Sec. III), mV/N.
 PCB_200B02_SENSITIVITY_MV_PER_N = 11.24

@@ -21,7 +21,10 @@ import math
 import numpy as np
 import pandas as pd
 
-from chain.regression import fit_fixed_exponent, fit_power_law
+from chain.analysis.regression import fit_fixed_exponent, fit_power_law
+from chain.analysis.rows import is_ok
+from chain.analysis.selection import GROUP as _GROUP
+from chain.analysis.selection import apply_selection
 
 #: Columns of :func:`delay_table`, in order (the last three are extras).
 DELAY_COLUMNS = (
@@ -63,34 +66,6 @@ DELAY_FIT_COLUMNS = (
 #: (first sensor met, sensor where the crossed wave is read) per wave.
 _PATH = {"LSTW": ("S1", "S2"), "RSTW": ("S2", "S1")}
 
-_GROUP = ["source", "model", "N"]
-
-
-def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
-    """Drop the rows of collision shots whose ``kept`` is False in ``selection``.
-
-    Shots are matched on ``shot`` and on whichever of ``source, model, N`` both tables
-    have. Reference shots and shots absent from ``selection`` are kept.
-
-    Parameters
-    ----------
-    table : DataFrame
-        Rows with a ``shot`` column (and ``kind`` if it holds reference shots).
-    selection : DataFrame or None
-        ``chain.protocol.select_shots`` output (``shot``, ``kept``, ...); None keeps all.
-    """
-    if selection is None:
-        return table
-    keys = [c for c in (*_GROUP, "shot") if c in table.columns and c in selection.columns]
-    dropped = selection.loc[~selection["kept"].astype(bool), keys].drop_duplicates()
-    if dropped.empty:
-        return table
-    marker = table[keys].merge(dropped.assign(_drop=True), on=keys, how="left")["_drop"]
-    drop = marker.fillna(False).to_numpy(dtype=bool)
-    if "kind" in table.columns:
-        drop &= (table["kind"] == "collision").to_numpy()
-    return table.loc[~drop]
-
 
 def reference_tofs(pulses: pd.DataFrame) -> pd.DataFrame:
     """S1 -> S2 time of flight of each ok reference shot, per estimator.
@@ -98,7 +73,7 @@ def reference_tofs(pulses: pd.DataFrame) -> pd.DataFrame:
     Parameters
     ----------
     pulses : DataFrame
-        ``pulses.csv`` rows (:func:`chain.pulses.pulse_table`).
+        ``pulses.csv`` rows (:func:`chain.analysis.pulses.pulse_table`).
 
     Returns
     -------
@@ -106,7 +81,7 @@ def reference_tofs(pulses: pd.DataFrame) -> pd.DataFrame:
         ``source, model, N, amplitude, estimator, shot, tof_s, tof_var_s2`` (the variance
         from the two arrival-time standard errors).
     """
-    ref = pulses[(pulses["role"] == "reference") & pulses["ok"].astype(bool)]
+    ref = pulses[(pulses["role"] == "reference") & is_ok(pulses)]
     keys = [*_GROUP, "amplitude", "estimator", "shot"]
     columns = [*keys, "T_s", "T_stderr_s"]
     both = ref.loc[ref["sensor"] == "S1", columns].merge(
@@ -123,7 +98,7 @@ def delay_table(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> 
     Parameters
     ----------
     pulses : DataFrame
-        ``pulses.csv`` rows (:func:`chain.pulses.pulse_table`).
+        ``pulses.csv`` rows (:func:`chain.analysis.pulses.pulse_table`).
     selection : DataFrame, optional
         Shot selection (``shot``, ``kept``); collision shots with ``kept`` False are
         dropped. None keeps every shot.
@@ -213,9 +188,9 @@ def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
     (source, model, estimator), from the ``ok`` rows of both waves:
 
     * ``C_us_N16``: least squares of |Delta| = C F_m^(-1/6), unweighted, standard error
-      from the residual scatter (:func:`chain.regression.fit_fixed_exponent`);
+      from the residual scatter (:func:`chain.analysis.regression.fit_fixed_exponent`);
     * ``exponent``, ``prefactor_free_us``: |Delta| = A F_m^p, straight line in log-log
-      (:func:`chain.regression.fit_power_law`).
+      (:func:`chain.analysis.regression.fit_power_law`).
 
     Fewer than 2 points (3 for the free exponent) give NaN and ``n_points``. In a
     simulation with sensors placed symmetrically, LSTW and RSTW are mirror images and
@@ -239,7 +214,7 @@ def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
         for (s, m, e), group in delays.groupby(["source", "model", "estimator"], sort=True)
     ]
     for (source, model, n_beads, estimator), group in groups + pooled:
-        used = group[group["ok"].astype(bool)]
+        used = group[is_ok(group)]
         force = used["F_m_N"].to_numpy(dtype=float)
         delay = np.abs(used["delay_us"].to_numpy(dtype=float))
         fixed = fit_fixed_exponent(force, delay, -1.0 / 6.0)

@@ -37,7 +37,7 @@ import pandas as pd
 from scipy.optimize import OptimizeWarning, curve_fit
 from scipy.signal import find_peaks, peak_widths, savgol_coeffs, savgol_filter
 
-from chain.materials import ParameterError
+from chain.errors import ParameterError
 from chain.traces import iter_shots, sensor_beads
 
 #: Names of the amplitude/arrival-time estimators, the paper's first.

@@ -34,9 +34,10 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import least_squares
 from scipy.signal import find_peaks, savgol_coeffs, savgol_filter
 
-from chain.delays import apply_selection
-from chain.pulses import estimate_baseline
-from chain.regression import fit_proportional
+from chain.analysis.pulses import estimate_baseline
+from chain.analysis.regression import fit_proportional
+from chain.analysis.rows import is_ok
+from chain.analysis.selection import apply_selection
 from chain.traces import iter_shots, sensor_beads
 
 #: The SSW is looked for from the crossed pulse's peak to this many tau after it.
@@ -224,7 +225,7 @@ def ssw_table(
     traces : DataFrame
         The trace table the pulses came from (:mod:`chain.traces`).
     pulses : DataFrame
-        ``pulses.csv`` rows of these traces (:func:`chain.pulses.pulse_table`).
+        ``pulses.csv`` rows of these traces (:func:`chain.analysis.pulses.pulse_table`).
     selection : DataFrame, optional
         Shot selection (``shot``, ``kept``); collision shots with ``kept`` False are
         dropped. None keeps every shot.
@@ -252,7 +253,7 @@ def ssw_table(
         for row in pulses.itertuples(index=False)
     }
     references = pulses[(pulses["role"] == "reference") & (pulses["sensor"] == "S2")]
-    references = references[references["ok"].astype(bool)]
+    references = references[is_ok(references)]
     collisions = pulses[pulses["kind"] == "collision"][[*keys, "shot", "amplitude"]]
     for shot in collisions.drop_duplicates().itertuples(index=False):
         if shot.shot not in signals:
@@ -345,7 +346,7 @@ def ssw_fit_table(ssw: pd.DataFrame, method: str = "residual") -> pd.DataFrame:
     """SSW = slope x F_m through the origin, per source, model and N (``ssw_fits.csv``).
 
     Unweighted least squares of the ``ok`` rows of ``method``, standard error from the
-    residual scatter (:func:`chain.regression.fit_proportional`); fewer than 2 points
+    residual scatter (:func:`chain.analysis.regression.fit_proportional`); fewer than 2 points
     give NaN and ``n_points``.
 
     Parameters
@@ -363,7 +364,7 @@ def ssw_fit_table(ssw: pd.DataFrame, method: str = "residual") -> pd.DataFrame:
     rows = []
     chosen = ssw[ssw["method"] == method]
     for (source, model, n_beads), group in chosen.groupby(["source", "model", "N"], sort=True):
-        used = group[group["ok"].astype(bool)]
+        used = group[is_ok(group)]
         fit = fit_proportional(used["F_m_N"].to_numpy(float), used["ssw_N"].to_numpy(float))
         rows.append(
             {

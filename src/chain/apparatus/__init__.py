@@ -1,0 +1,21 @@
+"""The apparatus: how traces come to be.
+
+Simulated shots (:mod:`.shots`), the acquisition chain (:mod:`.acquisition`), the
+virtual experiment, a model of the paper's apparatus (:mod:`.virtual`), and the
+reader of a lab's measured datasets (:mod:`.measured`).
+"""
+
+from chain._lazy import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(
+    __name__,
+    {
+        "simulate_shots": "chain.apparatus.shots",
+        "trace_table": "chain.apparatus.shots",
+        "VirtualExperiment": "chain.apparatus.virtual",
+        "run_virtual_experiment": "chain.apparatus.virtual",
+        "MeasuredDataError": "chain.apparatus.measured",
+        "load_dataset": "chain.apparatus.measured",
+        "read_metadata": "chain.apparatus.measured",
+    },
+)

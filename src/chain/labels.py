@@ -1,0 +1,11 @@
+"""Names a person reads in figures, tables and the summary, each defined once.
+
+The virtual experiment is a model of the apparatus, never data: every figure, table
+row and summary line that shows it carries :data:`VIRTUAL_LABEL`.
+"""
+
+#: Series name (``model`` column) of the virtual experiment's rows.
+VIRTUAL_SERIES = "virtual"
+
+#: Label of the virtual experiment's rows in figures and summary (not data).
+VIRTUAL_LABEL = "virtual experiment (model)"

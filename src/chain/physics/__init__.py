@@ -1,0 +1,38 @@
+"""The physics: materials, the chain model, the integrator, the closed forms.
+
+numpy, scipy and numba only: no pandas, no files, nothing from the other wings.
+"""
+
+from chain._lazy import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(
+    __name__,
+    {
+        **dict.fromkeys(
+            [
+                "MATERIALS",
+                "STEEL_100C6",
+                "Material",
+                "contact_stiffness",
+                "get_material",
+                "sphere_mass",
+            ],
+            "chain.physics.materials",
+        ),
+        **dict.fromkeys(
+            [
+                "PCB_200B02_STIFFNESS",
+                "ChainModel",
+                "Striker",
+                "build_chain",
+                "launch_velocities",
+                "uniform_chain",
+            ],
+            "chain.physics.model",
+        ),
+        **dict.fromkeys(["IntegrationError", "integrate"], "chain.physics.integrator"),
+        **dict.fromkeys(
+            ["SimulationResult", "default_time_step", "simulate"], "chain.physics.simulation"
+        ),
+    },
+)

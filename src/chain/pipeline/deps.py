@@ -1,0 +1,116 @@
+"""Which source files a workflow script runs: the rule inputs that follow the code.
+
+A rule must rerun when the code its script runs changes, and only then. The files are
+read off the import statements (``ast``, nothing is imported): the script's own local
+helpers (``_logging.py`` beside it), and every module of the ``chain`` package it
+imports, followed transitively, with the ``__init__`` files on the way. A new import
+in the library therefore needs no edit in the rules.
+"""
+
+from __future__ import annotations
+
+import ast
+import os
+from functools import cache
+from pathlib import Path
+
+#: The package whose files are followed.
+PACKAGE = "chain"
+
+
+def _imported_names(path: Path) -> list[tuple[str, list[str]]]:
+    """(module, names) of each import statement of ``path``, anywhere in the file;
+    relative imports are made absolute for files inside the package."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(alias.name, []) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            if node.level:
+                parts = _module_name(path).split(".")
+                base = parts[: len(parts) - node.level]
+                module = ".".join([*base, module] if module else base)
+            found.append((module, [alias.name for alias in node.names]))
+    return found
+
+
+def _module_name(path: Path) -> str:
+    """Dotted name of a file of the package (``chain.physics.model``)."""
+    parts = list(path.with_suffix("").parts)
+    parts = parts[len(parts) - 1 - parts[::-1].index(PACKAGE) :]
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _module_file(root: Path, dotted: str) -> Path | None:
+    """The file of module ``dotted`` under the package folder ``root``, or None."""
+    relative = Path(*dotted.split(".")[1:])
+    for candidate in (root / relative / "__init__.py", (root / relative).with_suffix(".py")):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _with_parents(root: Path, dotted: str) -> list[Path]:
+    """The module's file and the ``__init__`` files of the packages it is in."""
+    parts = dotted.split(".")
+    files = [_module_file(root, ".".join(parts[:k])) for k in range(1, len(parts) + 1)]
+    return [f for f in files if f is not None]
+
+
+@cache
+def _package_closure(root: Path, start: Path) -> frozenset[Path]:
+    """Every package file that importing ``start`` (a package file) runs."""
+    seen: set[Path] = set()
+    todo = [start]
+    while todo:
+        path = todo.pop()
+        if path in seen:
+            continue
+        seen.add(path)
+        for module, names in _imported_names(path):
+            todo += _targets(root, module, names)
+    return frozenset(seen)
+
+
+def _targets(root: Path, module: str, names: list[str]) -> list[Path]:
+    """Package files an import statement runs (``from chain.x import y``: y may be a
+    submodule)."""
+    if module != PACKAGE and not module.startswith(PACKAGE + "."):
+        return []
+    files = _with_parents(root, module)
+    files += [f for name in names if (f := _module_file(root, f"{module}.{name}"))]
+    return files
+
+
+def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) -> list[str]:
+    """Source files a workflow script runs, besides itself: its local helpers and the
+    package files it imports, transitively.
+
+    Parameters
+    ----------
+    script : path
+        The script (``workflow/scripts/fig4_delay_vs_force.py``).
+    package_dir : path
+        The ``chain`` package folder the jobs import (``src/chain``).
+
+    Returns
+    -------
+    list of str
+        Sorted paths relative to the current directory (so that a moved or copied
+        checkout names the same inputs).
+    """
+    script, root = Path(script).resolve(), Path(package_dir).resolve()
+    files: set[Path] = set()
+    for module, names in _imported_names(script):
+        local = script.parent / f"{module}.py"
+        if local.is_file():
+            files.add(local)
+        for target in _targets(root, module, names):
+            files |= _package_closure(root, target)
+    return sorted(_relative(path) for path in files)
+
+
+def _relative(path: Path) -> str:
+    return os.path.relpath(path, Path.cwd().resolve())

@@ -1,0 +1,138 @@
+"""The library's layering, read off the import statements (``ast``): imports run
+downhill only, so that physics can be read without tables, the analysis without
+figures, and the report without an integrator.
+
+    pipeline, cli          (config keys, results/, the command line)
+    report                 -> analysis, physics.theory/materials
+    apparatus | analysis   (side by side, no arrow between them)
+    physics                -> errors only
+    errors, atomic, traces, labels, _lazy
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "src" / "chain"
+BOTTOM = {"chain", "chain._lazy", "chain.errors", "chain.atomic", "chain.traces", "chain.labels"}
+
+#: Wing -> the chain modules or wings (prefixes) it may import.
+ALLOWED = {
+    "bottom": BOTTOM,
+    "physics": {"chain", "chain._lazy", "chain.errors", "chain.physics"},
+    "apparatus": BOTTOM | {"chain.physics", "chain.apparatus"},
+    "analysis": BOTTOM | {"chain.analysis"},
+    "report": BOTTOM
+    | {"chain.report", "chain.analysis", "chain.physics.theory", "chain.physics.materials"},
+    "pipeline": BOTTOM | {"chain.pipeline", "chain.physics", "chain.apparatus", "chain.analysis"},
+    "cli": {
+        "chain",
+        "chain._lazy",
+        "chain.errors",
+        "chain.atomic",
+        "chain.traces",
+        "chain.labels",
+        "chain.physics",
+        "chain.apparatus",
+        "chain.analysis",
+        "chain.pipeline",
+    },
+}
+
+#: Wing -> third-party packages it must not import.
+FORBIDDEN = {
+    "bottom": {"matplotlib", "numba", "scipy", "yaml"},
+    "physics": {"pandas", "matplotlib", "yaml"},
+    "apparatus": {"matplotlib"},
+    "analysis": {"matplotlib", "numba"},
+    "report": {"numba"},
+    "pipeline": {"matplotlib"},
+    "cli": set(),
+}
+
+
+def wing(module: str) -> str:
+    parts = module.split(".")
+    if len(parts) > 1 and parts[1] in ALLOWED:
+        return parts[1]
+    return "bottom"
+
+
+def modules() -> dict[str, Path]:
+    found = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        found[".".join(parts)] = path
+    return found
+
+
+def imports(path: Path) -> set[str]:
+    """Absolute names of every module imported anywhere in ``path`` (``from a import b``
+    gives ``a`` and ``a.b``, as b may be a submodule)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names.add(node.module)
+            names |= {f"{node.module}.{alias.name}" for alias in node.names}
+    return names
+
+
+def allowed(importer: str, imported: str) -> bool:
+    """May a module of ``importer``'s wing import ``imported``? (``chain`` itself is
+    allowed by exact name only; a wing allows its submodules.)"""
+    return any(
+        imported == prefix or (prefix != "chain" and imported.startswith(prefix + "."))
+        for prefix in ALLOWED[wing(importer)]
+    )
+
+
+MODULES = modules()
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_imports_run_downhill(module):
+    wrong = sorted(
+        name
+        for name in imports(MODULES[module])
+        if name.startswith("chain") and name in MODULES and not allowed(module, name)
+    )
+    assert not wrong, f"{module} ({wing(module)}) imports {wrong} against the layering"
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_forbidden_third_party_imports(module):
+    top = {name.split(".")[0] for name in imports(MODULES[module])}
+    wrong = sorted(top & (FORBIDDEN[wing(module)] | {"snakemake"}))
+    assert not wrong, f"{module} ({wing(module)}) imports {wrong}"
+
+
+def test_the_check_catches_an_uphill_import(tmp_path):
+    """The test itself: physics importing the report, or pandas, is caught."""
+    source = tmp_path / "bad.py"
+    source.write_text("import pandas\nfrom chain.report.summary import build_summary\n")
+    names = imports(source)
+    assert not allowed("chain.physics.model", "chain.report.summary")
+    assert "chain.report.summary" in names and "pandas" in {n.split(".")[0] for n in names}
+    assert allowed("chain.report.figures", "chain.analysis.rows")
+    assert not allowed("chain.report.figures", "chain.physics.integrator")
+    assert not allowed("chain.analysis.ssw", "chain.apparatus.virtual")
+
+
+def test_scripts_import_concrete_modules():
+    """Workflow scripts import from the module that defines a name, never the lazy
+    ``chain`` package itself: rule inputs are read off these imports."""
+    scripts = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
+    wrong = [
+        path.name
+        for path in sorted(scripts.glob("*.py"))
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.ImportFrom) and node.module in ("chain", "chain.physics")
+    ]
+    assert not wrong, wrong
