@@ -32,6 +32,7 @@ import yaml
 
 from chain.apparatus.acquisition import volts_to_newtons
 from chain.atomic import write_text_atomic
+from chain.errors import key_label
 from chain.traces import KINDS, META_COLUMNS, sensor_column, validate_traces
 
 #: Name of the metadata file of a dataset.
@@ -173,7 +174,7 @@ class _Checker:
                 break
             line = self.lines.get(path[:cut])
         at = f" line {line}" if line is not None else ""
-        label = _path_label(path)
+        label = key_label(path)
         return MeasuredDataError(f"{self.where}{at}: {label}{': ' if label else ''}{message}")
 
     def integer(self, path, value, minimum=None) -> int:
@@ -200,13 +201,6 @@ class _Checker:
         if not isinstance(value, str) or not value.strip():
             raise self.error(path, f"must be a non-empty string, got {value!r}")
         return value
-
-
-def _path_label(path: tuple) -> str:
-    label = ""
-    for part in path:
-        label += f"[{part}]" if isinstance(part, int) else (f".{part}" if label else str(part))
-    return label
 
 
 def parse_metadata(

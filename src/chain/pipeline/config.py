@@ -40,11 +40,12 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from chain.errors import ParameterError
+from chain.errors import key_label as key_name
 from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
 from chain.physics.materials import MATERIALS, get_material
 from chain.physics.theory import (
@@ -83,23 +84,6 @@ VIRTUAL_FIELDS = {
 
 class ConfigError(ValueError):
     """A configuration value is inconsistent; the message names the key."""
-
-
-def key_name(path: Iterable) -> str:
-    """Dotted name of a config key from its path, e.g. ``chains[0].N``.
-
-    Parameters
-    ----------
-    path : iterable of str and int
-        Keys (str) and list indices (int) from the top of the config.
-    """
-    name = ""
-    for part in path:
-        if isinstance(part, int):
-            name += f"[{part}]"
-        else:
-            name += f".{part}" if name else str(part)
-    return name or "<top level>"
 
 
 def _fail(path, message: str):
