@@ -1,4 +1,4 @@
-"""Figure functions (chain.report.figures) on small synthetic tables: they return Figures,
+"""Figure functions (chain.report.fig*) on small synthetic tables: they return Figures,
 draw what the captions say, and save byte-identical PDF/PNG files."""
 
 from __future__ import annotations
@@ -11,7 +11,13 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.physics.theory import cos6_pulse
-from chain.report import figures
+from chain.report import style
+from chain.report.fig1_setup import fig1_setup
+from chain.report.fig2_experiment_traces import fig2_experiment_traces
+from chain.report.fig3_simulation_traces import fig3_simulation_traces
+from chain.report.fig4_delay_vs_force import fig4_delay_vs_force
+from chain.report.fig5_ssw_vs_force import fig5_ssw_vs_force
+from chain.report.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
 from chain.traces import sensor_column, validate_traces
 
 #: Synthetic pulse: duration tau and the arrival times of the incident and crossed
@@ -220,7 +226,7 @@ def line_styles(ax):
 
 
 def test_fig1_draws_one_row_per_chain():
-    fig = figures.fig1_setup([{"N": 25, "sensors": [9, 17]}, {"N": 26, "sensors": [10, 17]}])
+    fig = fig1_setup([{"N": 25, "sensors": [9, 17]}, {"N": 26, "sensors": [10, 17]}])
     assert isinstance(fig, Figure)
     axes = fig.get_axes()
     assert len(axes) == 2
@@ -234,7 +240,7 @@ def test_fig1_draws_one_row_per_chain():
 
 def test_fig1_subsamples_many_chains():
     chains = [{"N": n, "sensors": [n // 2 - 3, n + 1 - (n // 2 - 3)]} for n in range(20, 32)]
-    fig = figures.fig1_setup(chains, max_rows=4)
+    fig = fig1_setup(chains, max_rows=4)
     assert len(fig.get_axes()) == 4
     assert "4 of 12 chains" in fig.get_suptitle()
 
@@ -244,9 +250,7 @@ def test_fig1_subsamples_many_chains():
 
 def test_fig3_layout_and_styles(trace_inputs):
     traces, pulses, ssw = trace_inputs
-    fig = figures.fig3_simulation_traces(
-        traces, pulses, ssw, model="elastic", representative_force_N=280
-    )
+    fig = fig3_simulation_traces(traces, pulses, ssw, model="elastic", representative_force_N=280)
     main = [ax for ax in fig.get_axes() if ax.get_title(loc="left")]
     titles = sorted(ax.get_title(loc="left") for ax in main)
     assert [t.split(")")[0] for t in titles] == ["(A", "(B", "(C", "(D"]
@@ -256,12 +260,12 @@ def test_fig3_layout_and_styles(trace_inputs):
     s1_styles = line_styles(by_title["(A)"])
     # reference dotted, then LSTW solid (incident) and RSTW dashed (crossed) at S1.
     assert s1_styles == [
-        (figures.REFERENCE_COLOR, ":"),
-        (figures.LSTW_COLOR, "-"),
-        (figures.RSTW_COLOR, "--"),
+        (style.REFERENCE_COLOR, ":"),
+        (style.LSTW_COLOR, "-"),
+        (style.RSTW_COLOR, "--"),
     ]
     s2_styles = line_styles(by_title["(B)"])
-    assert s2_styles[1:] == [(figures.RSTW_COLOR, "--"), (figures.LSTW_COLOR, "-")]
+    assert s2_styles[1:] == [(style.RSTW_COLOR, "--"), (style.LSTW_COLOR, "-")]
     insets = [inset for ax in main for inset in ax.child_axes]
     assert len(insets) == 4
     assert all(any("SSW 15 N" in t.get_text() for t in inset.texts) for inset in insets)
@@ -269,7 +273,7 @@ def test_fig3_layout_and_styles(trace_inputs):
 
 def test_fig3_split_is_at_the_minimum_between_pulses(trace_inputs):
     traces, pulses, _ = trace_inputs
-    fig = figures.fig3_simulation_traces(
+    fig = fig3_simulation_traces(
         traces[:1], pulses, None, model="elastic", representative_index=1, inset=False
     )
     ax = fig.get_axes()[0]
@@ -282,7 +286,7 @@ def test_fig3_split_is_at_the_minimum_between_pulses(trace_inputs):
 
 def test_fig3_without_pulse_table_picks_by_peak(trace_inputs):
     traces, _, _ = trace_inputs
-    fig = figures.fig3_simulation_traces(traces, model="elastic", representative_force_N=900)
+    fig = fig3_simulation_traces(traces, model="elastic", representative_force_N=900)
     ax = next(a for a in fig.get_axes() if a.get_title(loc="left"))
     peak = max(np.max(line.get_ydata()) for line in ax.get_lines())
     assert peak == pytest.approx(900.0, rel=0.01)
@@ -292,10 +296,10 @@ def test_fig2_takes_experiment_traces(trace_inputs):
     _, _, _ = trace_inputs
     traces = synthetic_traces(25, (9, 17), source="experiment", model="rig")
     pulses = synthetic_pulses(traces)
-    fig = figures.fig2_experiment_traces([traces], pulses, label="virtual experiment (model)")
+    fig = fig2_experiment_traces([traces], pulses, label="virtual experiment (model)")
     assert fig.get_suptitle().startswith("virtual experiment (model)")
     with pytest.raises(ValueError, match="no experiment traces"):
-        figures.fig2_experiment_traces([synthetic_traces(25)])
+        fig2_experiment_traces([synthetic_traces(25)])
 
 
 def test_fig2_draws_a_shot_the_protocol_kept(trace_inputs):
@@ -312,12 +316,12 @@ def test_fig2_draws_a_shot_the_protocol_kept(trace_inputs):
         }
     )
     selection["kept"] = selection["shot"] != 2
-    fig = figures.fig2_experiment_traces(
+    fig = fig2_experiment_traces(
         [traces], pulses, representative_force_N=300.0, selection=selection, label="lab"
     )
     title = next(ax.get_title(loc="left") for ax in fig.get_axes() if ax.get_title(loc="left"))
     assert "F$_m$ = 100 N" in title or "F$_m$ = 900 N" in title
-    everything = figures.fig2_experiment_traces([traces], pulses, representative_force_N=300.0)
+    everything = fig2_experiment_traces([traces], pulses, representative_force_N=300.0)
     title = next(
         ax.get_title(loc="left") for ax in everything.get_axes() if ax.get_title(loc="left")
     )
@@ -330,7 +334,7 @@ def test_trace_inset_stays_clear_of_the_traces(trace_inputs):
     traces = synthetic_traces(25, (9, 17), source="experiment", model="rig")
     short = traces[traces["t_s"] < 1.0e-3]
     pulses = synthetic_pulses(short)
-    fig = figures.fig2_experiment_traces([short], pulses, ssw=synthetic_ssw(pulses))
+    fig = fig2_experiment_traces([short], pulses, ssw=synthetic_ssw(pulses))
     fig.draw_without_rendering()  # final positions (constrained layout)
     for ax in (a for a in fig.get_axes() if a.get_title(loc="left")):
         (inset,) = ax.child_axes
@@ -346,7 +350,7 @@ def test_trace_inset_stays_clear_of_the_traces(trace_inputs):
 
 def test_fig4_lines_fits_and_references():
     constants = {"C_bal_paper_us_N16": 49.75, "C_bal_exact_us_N16": 37.74}
-    fig = figures.fig4_delay_vs_force(
+    fig = fig4_delay_vs_force(
         delays_table(),
         delay_fits_table(),
         constants=constants,
@@ -386,7 +390,7 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     delays.loc[experiment[:3], "ok"] = False  # flagged
     delays.loc[experiment[3], "delay_us"] = math.nan  # ok but NaN: a bug upstream
     with caplog.at_level("INFO", logger="chain.analysis.rows"):
-        fig = figures.fig4_delay_vs_force(delays, experiment_label="x")
+        fig = fig4_delay_vs_force(delays, experiment_label="x")
     drawn = sum(
         len(line.get_xdata())
         for line in fig.get_axes()[0].get_lines()
@@ -401,7 +405,7 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     ssw.loc[2, "ssw_N"] = -0.1  # below the noise: not on a log axis
     caplog.clear()
     with caplog.at_level("INFO", logger="chain.analysis.rows"):
-        fig = figures.fig5_ssw_vs_force(ssw, fits)
+        fig = fig5_ssw_vs_force(ssw, fits)
     points = [line for line in fig.get_axes()[0].get_lines() if line.get_linestyle() == "None"]
     assert sum(len(line.get_xdata()) for line in points) == len(ssw) - 3
     assert "Fig. 5 SSW rows: 3 of 16 left out (1 flagged ok = False, 1 ok but NaN" in caplog.text
@@ -411,13 +415,13 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
 def test_fig4_on_given_axes():
     fig = Figure()
     ax = fig.add_subplot()
-    assert figures.fig4_delay_vs_force(delays_table(), ax=ax) is fig
+    assert fig4_delay_vs_force(delays_table(), ax=ax) is fig
     assert ax.get_legend() is not None and not fig.legends
 
 
 def test_fig5_filled_simulation_open_experiment():
     ssw, fits = ssw_tables()
-    fig = figures.fig5_ssw_vs_force(ssw, fits, experiment_label="virtual experiment (model)")
+    fig = fig5_ssw_vs_force(ssw, fits, experiment_label="virtual experiment (model)")
     ax = fig.get_axes()[0]
     points = {line.get_label(): line for line in ax.get_lines() if line.get_linestyle() == "None"}
     sim = points[next(k for k in points if k.startswith("simulation, elastic, N = 25"))]
@@ -441,7 +445,7 @@ def test_parity_figure():
         }
         for n in range(20, 32)
     ]
-    fig = figures.fig_parity_ssw_vs_N(pd.DataFrame(rows))
+    fig = fig_parity_ssw_vs_N(pd.DataFrame(rows))
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert labels == ["simulation, elastic, even N", "simulation, elastic, odd N"]
 
@@ -453,8 +457,8 @@ def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
     traces, pulses, ssw = trace_inputs
     paths = []
     for name in ("a", "b"):
-        fig = figures.fig3_simulation_traces(traces, pulses, ssw, model="elastic")
-        paths.append(figures.save_figure(fig, tmp_path / name / "fig3_simulation_traces"))
+        fig = fig3_simulation_traces(traces, pulses, ssw, model="elastic")
+        paths.append(style.save_figure(fig, tmp_path / name / "fig3_simulation_traces"))
     for first, second in zip(*paths):
         assert first.read_bytes() == second.read_bytes(), first.name
     pdf, png = paths[0]
@@ -468,8 +472,8 @@ def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
 
 
 def test_model_colors_and_markers():
-    colors = figures.model_colors(["elastic", "viscoelastic", "custom"])
+    colors = style.model_colors(["elastic", "viscoelastic", "custom"])
     assert colors["elastic"] != colors["viscoelastic"] != colors["custom"]
-    assert figures.chain_marker(25) == "o" and figures.chain_marker(26) == "x"
-    assert figures.chain_marker(20, [20, 21]) != figures.chain_marker(21, [20, 21])
-    assert math.isfinite(figures.PNG_DPI)
+    assert style.chain_marker(25) == "o" and style.chain_marker(26) == "x"
+    assert style.chain_marker(20, [20, 21]) != style.chain_marker(21, [20, 21])
+    assert math.isfinite(style.PNG_DPI)

@@ -120,8 +120,8 @@ def test_the_check_catches_an_uphill_import(tmp_path):
     names = imports(source)
     assert not allowed("chain.physics.model", "chain.report.summary")
     assert "chain.report.summary" in names and "pandas" in {n.split(".")[0] for n in names}
-    assert allowed("chain.report.figures", "chain.analysis.rows")
-    assert not allowed("chain.report.figures", "chain.physics.integrator")
+    assert allowed("chain.report.fig4_delay_vs_force", "chain.analysis.rows")
+    assert not allowed("chain.report.fig4_delay_vs_force", "chain.physics.integrator")
     assert not allowed("chain.analysis.ssw", "chain.apparatus.virtual")
 
 

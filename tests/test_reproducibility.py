@@ -482,7 +482,7 @@ def test_a_failing_figure_save_leaves_no_file(tmp_path, monkeypatch):
     writing part of the file leaves nothing under the final names."""
     from matplotlib.figure import Figure
 
-    from chain.report.figures import save_figure
+    from chain.report.style import save_figure
 
     fig = Figure()
     fig.add_subplot().plot([0, 1], [1, 0])

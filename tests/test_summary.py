@@ -1,4 +1,4 @@
-"""summary.json / summary.md (chain.report.summary) from synthetic tables."""
+"""summary.json / summary.md (chain.report.summary, summary_md) from synthetic tables."""
 
 from __future__ import annotations
 
@@ -11,12 +11,8 @@ import pytest
 
 from chain.physics.theory import ballistic_constants as run_constants
 from chain.report.paper import PAPER
-from chain.report.summary import (
-    build_summary,
-    summary_json,
-    summary_markdown,
-    write_summary,
-)
+from chain.report.summary import build_summary, summary_json, write_summary
+from chain.report.summary_md import summary_markdown
 
 #: The paper's Eq. 6 value and our recomputation agree to the printed digits.
 CBAL_PAPER_ABS_US = 0.02

@@ -1,5 +1,6 @@
-# Figures: one rule per figure. They read tables and traces only, so restyling a
-# figure (src/chain/figures.py) redraws it and never reruns a simulation.
+# Figures: one rule, one script and one module (src/chain/report/<rule>.py) per figure.
+# They read tables and traces only, so restyling a figure redraws it and nothing else;
+# editing the shared style (report/style.py) redraws every figure.
 
 
 rule fig1_setup:
@@ -28,7 +29,7 @@ rule fig2_experiment_traces:
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
         selection=selection_files,
-        lib=code("fig_traces"),
+        lib=code("fig2_experiment_traces"),
     output:
         **figure_outputs("fig2_experiment_traces"),
     log:
@@ -38,14 +39,12 @@ rule fig2_experiment_traces:
     conda:
         ENV
     params:
-        model=None,
         representative_force_N=config["figures"]["experiment_force_N"]
         or config["figures"]["representative_force_N"],
-        representative_index=None,
         estimator=config["analysis"]["main_estimator"],
         label=experiment_label,
     script:
-        "../scripts/fig_traces.py"
+        "../scripts/fig2_experiment_traces.py"
 
 
 rule fig3_simulation_traces:
@@ -56,7 +55,7 @@ rule fig3_simulation_traces:
         ],
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
-        lib=code("fig_traces"),
+        lib=code("fig3_simulation_traces"),
     output:
         **figure_outputs("fig3_simulation_traces"),
     log:
@@ -72,7 +71,7 @@ rule fig3_simulation_traces:
         estimator=config["analysis"]["main_estimator"],
         label="simulation",
     script:
-        "../scripts/fig_traces.py"
+        "../scripts/fig3_simulation_traces.py"
 
 
 rule fig4_delay_vs_force:

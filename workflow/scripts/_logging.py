@@ -23,6 +23,9 @@ def start(snakemake) -> logging.Logger:
         force=True,
     )
     logging.captureWarnings(True)
+    # fontTools reports every font it subsets for a PDF at INFO (a hundred lines of glyph
+    # lists per figure): not about the run, and formatting them costs time.
+    logging.getLogger("fontTools").setLevel(logging.WARNING)
     logger = logging.getLogger(f"rule {snakemake.rule}")
     logger.info("inputs: %s", list(snakemake.input))
     logger.info("outputs: %s", list(snakemake.output))

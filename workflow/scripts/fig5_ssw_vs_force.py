@@ -1,11 +1,12 @@
-"""Fig. 5: SSW amplitude against incident amplitude (chain.report.figures.fig5_ssw_vs_force)."""
+"""Fig. 5: SSW amplitude against incident amplitude (chain.report.fig5_ssw_vs_force)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.figures import fig5_ssw_vs_force, save_figure
+from chain.report.fig5_ssw_vs_force import fig5_ssw_vs_force
+from chain.report.style import save_figure
 
 log = start(snakemake)
 fig = fig5_ssw_vs_force(

@@ -1,5 +1,12 @@
 """The report: figures and the summary, from the tables. It computes no physics.
 
-Plot functions take an ``ax`` and compute nothing; the paper's own numbers are in
-:mod:`.paper`, quoted as printed.
+One module per figure (``fig1_setup``, ``fig2_experiment_traces``,
+``fig3_simulation_traces``, ``fig4_delay_vs_force``, ``fig5_ssw_vs_force``,
+``fig_parity_ssw_vs_N``), with the panels Fig. 2 and 3 share in :mod:`.trace_panels`;
+the look of every figure (rc parameters, colours, markers, saving) in :mod:`.style`; the
+table look-ups that choose what to draw in :mod:`.picks`. Plot functions take an ``ax``
+where they draw one axes, and compute nothing. ``summary.json`` is built in
+:mod:`.summary`, ``summary.md`` written in :mod:`.summary_md`; the paper's own numbers
+are in :mod:`.paper`, quoted as printed. A new figure is a new module here, a script in
+``workflow/scripts`` and a rule in ``workflow/rules/figures.smk``.
 """

@@ -1,0 +1,179 @@
+"""The one home of the figures' look: rc parameters, colours, markers, labels, saving.
+
+Every figure module draws inside ``matplotlib.rc_context(STYLE)`` and saves with
+:func:`save_figure`, so that fonts, sizes and file metadata are the same in every figure
+and two rebuilds give identical bytes. Figures are built without pyplot (no global
+state, no display backend). Editing this module redraws every figure, and nothing else.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib as mpl
+from matplotlib.figure import Figure
+
+from chain.atomic import atomic_output
+
+#: Resolution of the PNG files, dots per inch.
+PNG_DPI = 200
+
+#: rcParams applied while drawing and saving: fixed fonts and sizes, and the settings
+#: that make the written bytes depend on nothing but the figure.
+STYLE = {
+    "font.family": "DejaVu Sans",
+    "font.size": 8,
+    "axes.titlesize": 8,
+    "axes.labelsize": 8,
+    "legend.fontsize": 7,
+    "xtick.labelsize": 7,
+    "ytick.labelsize": 7,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "lines.linewidth": 1.2,
+    "pdf.fonttype": 42,
+    "svg.hashsalt": "hertzchain",
+    "svg.fonttype": "none",
+    "path.simplify": False,
+}
+
+#: Metadata written in the files: no dates, no software version.
+PDF_METADATA = {"CreationDate": None, "ModDate": None, "Producer": None, "Creator": None}
+PNG_METADATA = {"Software": None}
+
+#: Colours of the contact models (others take the next colours of the cycle).
+MODEL_COLORS = {"elastic": "#1f77b4", "viscoelastic": "#d95f02"}
+_EXTRA_COLORS = ("#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f")
+
+#: Markers of the chains in Fig. 4/5 (paper: N = 25 circles, N = 26 crosses).
+N_MARKERS = {25: "o", 26: "x"}
+_EXTRA_MARKERS = ("s", "^", "D", "v", "P", "<", ">", "*")
+
+#: Colours of the waves in the trace figures (and the setup's wave arrows).
+LSTW_COLOR = "#1f4e9c"
+RSTW_COLOR = "#c0392b"
+REFERENCE_COLOR = "black"
+#: Colour of the secondary solitary wave's marker.
+SSW_COLOR = "#2a7f3f"
+
+#: Seconds to microseconds, for time axes.
+MICRO = 1e6
+
+
+# ---- saving ---------------------------------------------------------------------
+
+
+def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
+    """Write ``fig`` as ``<path>.pdf`` and ``<path>.png`` with fixed metadata.
+
+    Each file is written to a temporary name beside its destination and renamed, so
+    an interrupted write never leaves a partial figure. No creation date or software
+    version goes into the files: two rebuilds of the same figure give the same bytes.
+
+    Parameters
+    ----------
+    fig : Figure
+        The figure.
+    path : path
+        Destination without extension; parent folders are created.
+
+    Returns
+    -------
+    list of Path
+        The PDF and PNG paths.
+    """
+    stem = Path(path)
+    if stem.suffix in (".pdf", ".png"):
+        stem = stem.with_suffix("")
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    with mpl.rc_context(STYLE):
+        for extension, options in (
+            ("pdf", {"metadata": PDF_METADATA}),
+            ("png", {"metadata": PNG_METADATA, "dpi": PNG_DPI}),
+        ):
+            target = stem.with_name(f"{stem.name}.{extension}")
+            with atomic_output(target) as temporary:
+                fig.savefig(temporary, format=extension, **options)
+            written.append(target)
+    return written
+
+
+# ---- figures and axes -------------------------------------------------------------
+
+
+def new_figure(width: float, height: float) -> Figure:
+    """A figure of ``width`` x ``height`` inches with constrained layout, in the style."""
+    with mpl.rc_context(STYLE):
+        return Figure(figsize=(width, height), layout="constrained")
+
+
+def axes_or_new(ax, width: float = 4.8, height: float = 3.6):
+    """``(figure, axes)``: the given axes and their figure, or new axes on a new figure
+    of ``width`` x ``height`` inches."""
+    if ax is not None:
+        return ax.figure, ax
+    fig = new_figure(width, height)
+    with mpl.rc_context(STYLE):
+        return fig, fig.add_subplot()
+
+
+def add_legend(fig, ax, own: bool, loc: str) -> None:
+    """Below the axes on a figure of our own (never over the data); inside otherwise,
+    at ``loc``."""
+    if own:
+        fig.legend(
+            *ax.get_legend_handles_labels(),
+            loc="outside lower center",
+            ncol=2,
+            fontsize=6,
+            frameon=False,
+        )
+    else:
+        ax.legend(loc=loc, fontsize=6, frameon=False)
+
+
+def plain_log_ticks(axis) -> None:
+    """Ticks 1, 1.5, 2, 3, 5, 7 x 10^k written as plain numbers on a short log axis."""
+    axis.set_major_locator(mpl.ticker.LogLocator(base=10, subs=(1.0, 1.5, 2.0, 3.0, 5.0, 7.0)))
+    axis.set_major_formatter(mpl.ticker.StrMethodFormatter("{x:g}"))
+    axis.set_minor_formatter(mpl.ticker.NullFormatter())
+
+
+def plain_numbers(axis) -> None:
+    """Major tick labels of ``axis`` written as plain numbers (``{x:g}``)."""
+    axis.set_major_formatter(mpl.ticker.StrMethodFormatter("{x:g}"))
+
+
+# ---- colours, markers, labels ------------------------------------------------------
+
+
+def model_colors(models: Sequence[str]) -> dict[str, str]:
+    """A colour per model name: fixed for elastic/viscoelastic, the cycle otherwise."""
+    colors = {}
+    extra = iter(_EXTRA_COLORS * 4)
+    for name in models:
+        colors[name] = MODEL_COLORS.get(name) or next(extra)
+    return colors
+
+
+def chain_marker(n: int, order: Sequence[int] = ()) -> str:
+    """Marker of the chain of ``n`` beads: circle for 25, cross for 26 as in the paper;
+    other chains take the next markers in the order of ``order``."""
+    if n in N_MARKERS:
+        return N_MARKERS[n]
+    others = [m for m in order if m not in N_MARKERS]
+    index = others.index(n) if n in others else 0
+    return _EXTRA_MARKERS[index % len(_EXTRA_MARKERS)]
+
+
+def source_label(source: str, experiment_label: str) -> str:
+    """Name of a table's ``source`` in legends: ``experiment_label`` for experiment rows."""
+    return experiment_label if source == "experiment" else "simulation"
+
+
+def us_n16(value: float) -> str:
+    """A constant C in µs N^(1/6), for legends."""
+    return f"{value:.2f} µs N$^{{1/6}}$"

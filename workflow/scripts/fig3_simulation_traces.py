@@ -1,0 +1,25 @@
+"""Fig. 3: simulated forces at the sensor beads (chain.report.fig3_simulation_traces)."""
+
+from pathlib import Path
+
+import pandas as pd
+from _logging import start
+
+from chain.report.fig3_simulation_traces import fig3_simulation_traces
+from chain.report.style import save_figure
+from chain.traces import read_traces
+
+log = start(snakemake)
+p = snakemake.params
+fig = fig3_simulation_traces(
+    [read_traces(path) for path in snakemake.input.traces],
+    pd.read_csv(snakemake.input.pulses),
+    pd.read_csv(snakemake.input.ssw),
+    model=p.model,
+    representative_force_N=p.representative_force_N,
+    representative_index=p.representative_index,
+    estimator=p.estimator,
+    label=p.label,
+)
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+log.info("done")
