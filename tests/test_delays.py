@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from chain.analysis.delays import DELAY_COLUMNS, DELAY_FIT_COLUMNS, delay_fit_table, delay_table
-from chain.analysis.pulses import pulse_table
+from chain.analysis.pulse_rows import pulse_table
 from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
@@ -128,6 +128,19 @@ def test_missing_reference_or_pulse_gives_flagged_rows():
     flagged = delays_of(validate_traces(silent))
     assert not flagged["ok"].any()
     assert flagged["reason"].str.contains("no pulse detected").all()
+
+
+def test_ok_flag_read_as_text_gives_the_same_delays():
+    """A pulses table whose ``ok`` column holds text ("True"/"False", as a hand-edited
+    or re-typed CSV may) gives the same delays: the text "False" flags the pulse."""
+    pulses = pulse_table(synthetic_traces(-5e-6, -5e-6, n_references=2))
+    # Flag the incident LSTW pulse at S1 of the collision shot.
+    flagged = (pulses["shot"] == 0) & (pulses["sensor"] == "S1") & (pulses["role"] == "incident")
+    pulses.loc[flagged, ["ok", "reason"]] = [False, "flagged by hand"]
+    as_text = pulses.assign(ok=pulses["ok"].map({True: "True", False: "False"}))
+    expected = delay_table(pulses)
+    pd.testing.assert_frame_equal(delay_table(as_text), expected)
+    assert list(expected.set_index("wave")["ok"]) == [False, True]
 
 
 def synthetic_delay_rows(constant_us, forces, n_beads, exponent=-1.0 / 6.0):

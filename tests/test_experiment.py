@@ -68,8 +68,8 @@ NOISE_FREE = dataclasses.replace(
 @pytest.mark.parametrize(
     ("change", "fragment"),
     [
-        ({"sensor_beads": (9, 30)}, "sensor_beads must be beads in 1..25"),
-        ({"sensor_beads": (17, 9)}, "sensor_beads must increase"),
+        ({"sensor_beads": (9, 30)}, "sensor_beads: bead 30 is outside the chain 1..25"),
+        ({"sensor_beads": (17, 9)}, r"sensor_beads: must be strictly increasing \(S1 first\)"),
         ({"impact_speeds_m_s": (1.0,), "drop_heights_m": (0.1,)}, "not both"),
         ({"impact_speeds_m_s": (1.0, -2.0)}, "impact_speeds_m_s must be a positive"),
         ({"sensitivity_mV_per_N": (11.24,)}, "one value per sensor"),

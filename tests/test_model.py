@@ -42,6 +42,10 @@ def test_sensor_bead_is_two_halves_and_a_spring(bead_mass, kappa, tol):
     np.testing.assert_allclose(model.bead_masses, bead_mass, rtol=tol.roundoff)
     assert model.masses.sum() == pytest.approx(26 * bead_mass, rel=tol.roundoff)
     assert model.sensor_beads == (10, 17)
+    # The model's sensors are a set: any order gives the same chain.
+    unordered = uniform_chain(26, sensor_beads=[17, 10])
+    assert unordered.sensor_beads == (10, 17)
+    np.testing.assert_array_equal(unordered.sensor_link, model.sensor_link)
     assert np.all(model.link_kind[model.sensor_link] == SPRING)
     np.testing.assert_allclose(model.link_stiffness[model.sensor_link], PCB_200B02_STIFFNESS)
     for link in model.sensor_link:
@@ -115,9 +119,10 @@ def test_bead_index_is_one_based():
         (lambda: build_chain([1.0, -1.0], [1.0]), r"bead_masses\[bead 2\]"),
         (lambda: build_chain([1.0, 1.0], [1.0, 1.0]), "contact_stiffnesses"),
         (lambda: build_chain([1.0, 1.0, 1.0], [1.0, 0.0]), r"contact_stiffnesses\[contact 2\]"),
-        (lambda: uniform_chain(26, sensor_beads=[0]), "sensor_beads"),
-        (lambda: uniform_chain(26, sensor_beads=[27]), "sensor_beads"),
-        (lambda: uniform_chain(26, sensor_beads=[10, 10]), "sensor_beads"),
+        (lambda: uniform_chain(26, sensor_beads=[0]), "sensor_beads: bead 0 is outside"),
+        (lambda: uniform_chain(26, sensor_beads=[27]), r"sensor_beads: bead 27 .* 1\.\.26"),
+        (lambda: uniform_chain(26, sensor_beads=[10, 10]), "sensor_beads: duplicate bead"),
+        (lambda: uniform_chain(26, sensor_beads=[10.5]), "sensor_beads: .* must be integers"),
         (lambda: uniform_chain(26, sensor_beads=[10], sensor_stiffness=0.0), "sensor_stiffness"),
         (lambda: uniform_chain(26, eta=-1e-6), "eta"),
         (lambda: build_chain([1.0, 1.0, 1.0], [1.0, 1.0], eta=[0.0, -1.0]), "eta"),
@@ -126,6 +131,7 @@ def test_bead_index_is_one_based():
         (lambda: uniform_chain(26, striker_radius=4e-3, strikers="middle"), "strikers"),
         (lambda: uniform_chain(26, striker_radius=-4e-3), "radius"),
         (lambda: uniform_chain(26, left_wall=True, striker_radius=4e-3), "left_striker"),
+        (lambda: uniform_chain(26, right_wall=True, striker_radius=4e-3), "right_striker"),
         (lambda: build_chain([1.0, 1.0], [1.0], left_wall_stiffness=-1.0), "left_wall_stiffness"),
         (lambda: build_chain([1.0, 1.0], [1.0], right_wall_stiffness=math.nan), "right_wall"),
         (lambda: Striker(mass=0.0, contact_stiffness=1.0), "striker mass"),

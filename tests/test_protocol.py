@@ -62,6 +62,12 @@ def pulses():
     return pd.DataFrame(rows)
 
 
+def test_ok_flag_read_as_text_gives_the_same_selection(pulses):
+    """``ok`` as text ("True"/"False") is read like the booleans: "False" rejects."""
+    as_text = pulses.assign(ok=pulses["ok"].map({True: "True", False: "False"}))
+    pd.testing.assert_frame_equal(select_shots(as_text), select_shots(pulses))
+
+
 def test_mismatch_definition():
     assert amplitude_mismatch(30.0, 30.6) == pytest.approx(0.6 / 30.3)
     assert amplitude_mismatch(10.0, 10.0) == 0.0

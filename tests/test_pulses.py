@@ -8,14 +8,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from chain.analysis.pulse_rows import PULSE_COLUMNS, pulse_table
 from chain.analysis.pulses import (
     COS6_FWHM_PER_TAU,
     ESTIMATORS,
-    PULSE_COLUMNS,
     estimate_baseline,
     find_pulses,
     fit_pulse,
-    pulse_table,
 )
 from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
@@ -215,3 +214,15 @@ def test_pulse_table_roles_and_flagged_rows():
     assert silent["F_m_N"].isna().all()
     assert fits.loc[(2, "S2", "incident"), "ok"]
     assert not fits.loc[(2, "S2", "crossed"), "ok"]
+
+
+def test_pulse_table_importable_from_its_old_home():
+    """The table moved to chain.analysis.pulse_rows; chain.pulse_table and
+    chain.analysis.pulses.pulse_table still name the same function."""
+    import chain
+    import chain.analysis.pulses as pulses
+
+    assert pulses.pulse_table is pulse_table is chain.pulse_table
+    assert pulses.PULSE_COLUMNS is PULSE_COLUMNS
+    with pytest.raises(AttributeError):
+        pulses.no_such_name  # noqa: B018

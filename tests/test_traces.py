@@ -126,7 +126,7 @@ def test_non_finite_value_names_the_column(traces, column, value):
         ("kind", "crossing", "kind must be one of"),
         ("source", "lab", "source must be one of"),
         ("shot", 1.5, "column shot must hold integers"),
-        ("N", 3, "sensor beads \\[10, 17\\] outside the chain 1..3"),
+        ("N", 3, "sensor columns \\(beads \\[10, 17\\]\\): bead 10 is outside the chain 1..3"),
     ],
 )
 def test_bad_metadata_is_named(traces, column, value, message):
@@ -135,6 +135,14 @@ def test_bad_metadata_is_named(traces, column, value, message):
     bad[column] = value
     with pytest.raises(TraceFormatError, match=message):
         validate_traces(bad)
+
+
+def test_sensor_columns_must_put_s1_first(traces):
+    """S1 is the first sensor column and the left-launched wave meets it first, so the
+    sensor columns run in increasing bead order; the message says so."""
+    swapped = traces[[*META_COLUMNS, "force_bead17_N", "force_bead10_N"]]
+    with pytest.raises(TraceFormatError, match=r"strictly increasing \(S1 first\), got \[17, 10\]"):
+        validate_traces(swapped)
 
 
 def test_error_messages_say_which_file(traces, tmp_path):

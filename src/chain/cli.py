@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from chain.apparatus.shots import trace_table
 from chain.errors import ParameterError
 from chain.physics.integrator import IntegrationError
-from chain.physics.materials import MATERIALS, contact_stiffness, get_material, sphere_mass
+from chain.physics.materials import MATERIALS, get_material
 from chain.physics.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
 from chain.physics.simulation import DEFAULT_RECORD_INTERVAL, simulate
 from chain.traces import TraceFormatError, write_traces
@@ -45,7 +45,12 @@ def _build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="command")
+    for add_command in (_add_simulate, _add_analyse, _add_theory, _add_check):
+        add_command(commands)
+    return parser
 
+
+def _add_simulate(commands) -> None:
     sim = commands.add_parser(
         "simulate",
         help="simulate one launch and write a trace file",
@@ -79,6 +84,13 @@ def _build_parser() -> argparse.ArgumentParser:
         default=None,
         help="beads to record, S1 first (default: every bead 1..N)",
     )
+    _add_chain_options(sim)
+    sim.add_argument("--model-name", default="cli", help="value of the trace 'model' column")
+    sim.add_argument("-o", "--output", required=True, help="output trace CSV path")
+
+
+def _add_chain_options(sim) -> None:
+    """The options of ``simulate`` that describe the chain (beads, sensors, strikers)."""
     sim.add_argument(
         "--material",
         choices=sorted(MATERIALS),
@@ -110,9 +122,9 @@ def _build_parser() -> argparse.ArgumentParser:
         help="launch with spherical strikers of this radius, m (paper: 4e-3) "
         "instead of giving V0 to the end beads",
     )
-    sim.add_argument("--model-name", default="cli", help="value of the trace 'model' column")
-    sim.add_argument("-o", "--output", required=True, help="output trace CSV path")
 
+
+def _add_analyse(commands) -> None:
     analyse = commands.add_parser(
         "analyse",
         help="fit the pulses of a trace file",
@@ -126,6 +138,8 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     analyse.add_argument("-o", "--output", default=None, help="write the table here (CSV)")
 
+
+def _add_theory(commands) -> None:
     theory = commands.add_parser(
         "theory",
         help="print closed forms for a material",
@@ -137,6 +151,9 @@ def _build_parser() -> argparse.ArgumentParser:
     theory.add_argument(
         "--force", type=float, default=100.0, help="peak force F_m for the wave speed, N"
     )
+
+
+def _add_check(commands) -> None:
     check = commands.add_parser(
         "check",
         help="check a run against the results contract and a reference",
@@ -158,7 +175,6 @@ def _build_parser() -> argparse.ArgumentParser:
         help="instead of checking, (re)write the reference from this run, recording WHY; "
         "commit it only in a reviewed commit that says why",
     )
-    return parser
 
 
 def _check(args: argparse.Namespace) -> int:
@@ -227,7 +243,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _analyse(args: argparse.Namespace) -> int:
-    from chain.analysis.pulses import pulse_table  # analysis is imported only when asked for
+    from chain.analysis.pulse_rows import pulse_table  # analysis is imported only when asked for
     from chain.traces import read_traces
 
     table = pulse_table(read_traces(args.traces), estimators=(args.estimator,))
@@ -245,15 +261,11 @@ def _theory(args: argparse.Namespace) -> int:
 
     material = get_material(args.material)
     radius = args.radius
-    mass = sphere_mass(material, radius)
-    kappa = contact_stiffness(material, radius, material, radius)
     values = {
         "material": material.name,
         "radius_m": radius,
-        "kappa_N_m1_5": kappa,
-        "bead_mass_kg": mass,
-        "C_bal_paper_us_N16": theory.ballistic_delay_constant_paper(material, radius) * 1e6,
-        "C_bal_exact_us_N16": theory.ballistic_delay_constant_exact(material, radius) * 1e6,
+        # kappa, bead mass, C_bal as printed and exact: the run constants of summary.json
+        **theory.ballistic_constants(material.name, radius),
         "F_m_N": args.force,
         "wave_speed_m_s": theory.nesterenko_speed_from_force(args.force, material, radius),
         "bead_velocity_m_s": theory.bead_velocity_from_force(args.force, material, radius),

@@ -18,9 +18,9 @@ column             type    meaning
 ``force_bead<n>_N`` float  force read at bead n, N, one column per sensor bead, in order
 =================  ======  ==========================================================
 
-Sensors are beads 1..N. The first sensor column is S1 (met first by the left-launched
-wave, LSTW), the last is S2. Within a shot, time is strictly increasing and evenly
-sampled.
+Sensors are beads 1..N, in increasing order: the first sensor column is S1 (met first
+by the left-launched wave, LSTW), the last is S2. Within a shot, time is strictly
+increasing and evenly sampled.
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from chain.atomic import write_csv_atomic
+from chain.errors import bead_number_problem
 
 #: Columns every trace table has, in order, before the sensor columns.
 META_COLUMNS = (
@@ -112,9 +113,9 @@ def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataF
     if len(n_values) != 1 or n_values[0] < 2:
         raise TraceFormatError(f"{where}: column N must hold one chain size >= 2, got {n_values}")
     n_beads = int(n_values[0])
-    outside = [b for b in beads if not 1 <= b <= n_beads]
-    if outside:
-        raise TraceFormatError(f"{where}: sensor beads {outside} outside the chain 1..{n_beads}")
+    problem = bead_number_problem(beads, n_beads)
+    if problem:
+        raise TraceFormatError(f"{where}: sensor columns (beads {beads}): {problem}")
     for column in ("v0_left_m_s", "v0_right_m_s", "t_s", *map(sensor_column, beads)):
         out[column] = pd.to_numeric(out[column], errors="coerce").astype(float)
     for column in ("t_s", *map(sensor_column, beads)):

@@ -1,9 +1,9 @@
-"""Fit the pulses of every trace file (chain.analysis.pulses.pulse_table)."""
+"""Fit the pulses of every trace file (chain.analysis.pulse_rows.pulse_table)."""
 
 import pandas as pd
 from _logging import start
 
-from chain.analysis.pulses import pulse_table
+from chain.analysis.pulse_rows import pulse_table
 from chain.atomic import write_csv_atomic
 from chain.traces import read_traces
 

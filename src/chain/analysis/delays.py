@@ -73,7 +73,7 @@ def reference_tofs(pulses: pd.DataFrame) -> pd.DataFrame:
     Parameters
     ----------
     pulses : DataFrame
-        ``pulses.csv`` rows (:func:`chain.analysis.pulses.pulse_table`).
+        ``pulses.csv`` rows (:func:`chain.analysis.pulse_rows.pulse_table`).
 
     Returns
     -------
@@ -98,7 +98,7 @@ def delay_table(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> 
     Parameters
     ----------
     pulses : DataFrame
-        ``pulses.csv`` rows (:func:`chain.analysis.pulses.pulse_table`).
+        ``pulses.csv`` rows (:func:`chain.analysis.pulse_rows.pulse_table`).
     selection : DataFrame, optional
         Shot selection (``shot``, ``kept``); collision shots with ``kept`` False are
         dropped. None keeps every shot.
@@ -117,6 +117,8 @@ def delay_table(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> 
         for key, group in refs.groupby([*_GROUP, "amplitude", "estimator"])
     }
     collision = pulses[pulses["kind"] == "collision"]
+    # One reading of the flag: a row's ``ok`` below is a bool however the table was read.
+    collision = collision.assign(ok=is_ok(collision))
     lookup = {
         (row.source, row.model, row.N, row.shot, row.estimator, row.sensor, row.role): row
         for row in collision.itertuples(index=False)
@@ -125,54 +127,57 @@ def delay_table(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> 
     shots = collision[[*_GROUP, "shot", "amplitude", "estimator"]].drop_duplicates()
     for shot in shots.itertuples(index=False):
         key = (shot.source, shot.model, shot.N, shot.amplitude, shot.estimator)
-        tof_ref, var_ref, n_ref = ref_stats.get(key, (math.nan, math.nan, 0))
+        reference = ref_stats.get(key, (math.nan, math.nan, 0))
+        where = (shot.source, shot.model, shot.N, shot.shot, shot.estimator)
         for wave, (first, crossed_at) in _PATH.items():
-            where = (shot.source, shot.model, shot.N, shot.shot, shot.estimator)
             incident = lookup.get((*where, first, "incident"))
             crossed = lookup.get((*where, crossed_at, "crossed"))
-            row = {
-                "source": shot.source,
-                "model": shot.model,
-                "N": shot.N,
-                "shot": shot.shot,
-                "amplitude": shot.amplitude,
-                "wave": wave,
-                "estimator": shot.estimator,
-                "n_reference": n_ref,
-            }
-            reasons = []
-            if incident is None or not bool(incident.ok):
-                reasons.append(f"incident {wave} at {first}: {_why(incident)}")
-            if crossed is None or not bool(crossed.ok):
-                reasons.append(f"crossed {wave} at {crossed_at}: {_why(crossed)}")
-            if n_ref == 0:
-                reasons.append("no usable reference shot of this amplitude")
-            f_m = incident.F_m_N if incident is not None else math.nan
-            tof = (
-                crossed.T_s - incident.T_s
-                if incident is not None and crossed is not None
-                else math.nan
-            )
-            ok = not reasons
-            row.update(
-                {
-                    "F_m_N": f_m if ok else math.nan,
-                    "delay_us": (tof - tof_ref) * 1e6 if ok else math.nan,
-                    "tof_crossed_us": tof * 1e6 if ok else math.nan,
-                    "tof_reference_us": tof_ref * 1e6,
-                    "ok": ok,
-                    "reason": "; ".join(reasons),
-                    "F_m_stderr_N": incident.F_m_stderr_N if ok else math.nan,
-                    "delay_stderr_us": (
-                        math.sqrt(incident.T_stderr_s**2 + crossed.T_stderr_s**2 + var_ref) * 1e6
-                        if ok
-                        else math.nan
-                    ),
-                    "F_crossed_N": crossed.F_m_N if ok else math.nan,
-                }
-            )
-            rows.append(row)
+            rows.append(_delay_row(shot, wave, incident, crossed, reference))
     return pd.DataFrame(rows, columns=DELAY_COLUMNS)
+
+
+def _delay_row(shot, wave: str, incident, crossed, reference: tuple) -> dict:
+    """The ``delays.csv`` row of one wave of one collision shot.
+
+    ``shot`` holds source, model, N, shot, amplitude and estimator; ``incident`` and
+    ``crossed`` are the pulse rows the wave needs (None when absent); ``reference`` is
+    (mean reference TOF s, its variance s^2, number of reference shots).
+    """
+    first, crossed_at = _PATH[wave]
+    tof_ref, var_ref, n_ref = reference
+    reasons = []
+    if incident is None or not incident.ok:
+        reasons.append(f"incident {wave} at {first}: {_why(incident)}")
+    if crossed is None or not crossed.ok:
+        reasons.append(f"crossed {wave} at {crossed_at}: {_why(crossed)}")
+    if n_ref == 0:
+        reasons.append("no usable reference shot of this amplitude")
+    f_m = incident.F_m_N if incident is not None else math.nan
+    tof = crossed.T_s - incident.T_s if incident is not None and crossed is not None else math.nan
+    ok = not reasons
+    return {
+        "source": shot.source,
+        "model": shot.model,
+        "N": shot.N,
+        "shot": shot.shot,
+        "amplitude": shot.amplitude,
+        "wave": wave,
+        "estimator": shot.estimator,
+        "n_reference": n_ref,
+        "F_m_N": f_m if ok else math.nan,
+        "delay_us": (tof - tof_ref) * 1e6 if ok else math.nan,
+        "tof_crossed_us": tof * 1e6 if ok else math.nan,
+        "tof_reference_us": tof_ref * 1e6,
+        "ok": ok,
+        "reason": "; ".join(reasons),
+        "F_m_stderr_N": incident.F_m_stderr_N if ok else math.nan,
+        "delay_stderr_us": (
+            math.sqrt(incident.T_stderr_s**2 + crossed.T_stderr_s**2 + var_ref) * 1e6
+            if ok
+            else math.nan
+        ),
+        "F_crossed_N": crossed.F_m_N if ok else math.nan,
+    }
 
 
 def _why(pulse) -> str:

@@ -20,8 +20,8 @@ with one of the :data:`ESTIMATORS`:
     whatever trails the peak).
 
 A measurement that cannot be made gives a :class:`PulseFit` with ``ok=False`` and a
-``reason``, never an exception. :func:`pulse_table` turns a trace table
-(:mod:`chain.traces`) into the rows of ``pulses.csv`` (see ``docs/interfaces.md``).
+``reason``, never an exception. :func:`chain.analysis.pulse_rows.pulse_table` applies
+both to every sensor signal of a trace table (the rows of ``pulses.csv``).
 
 SI units inside; table columns carry their unit.
 """
@@ -30,15 +30,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 from scipy.optimize import OptimizeWarning, curve_fit
 from scipy.signal import find_peaks, peak_widths, savgol_coeffs, savgol_filter
 
 from chain.errors import ParameterError
-from chain.traces import iter_shots, sensor_beads
 
 #: Names of the amplitude/arrival-time estimators, the paper's first.
 ESTIMATORS = ("fit_full", "peak", "fit_rise")
@@ -455,142 +453,11 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
     )
 
 
-def pulse_table(
-    traces: pd.DataFrame,
-    estimators=("fit_full",),
-    *,
-    rel_prominence: float = DEFAULT_REL_PROMINENCE,
-    min_snr: float = DEFAULT_MIN_SNR,
-    min_height_N: float = 0.0,
-) -> pd.DataFrame:
-    """The rows of ``pulses.csv``: every main pulse of every shot, per estimator.
+def __getattr__(name: str):
+    # The pulses table moved to chain.analysis.pulse_rows; its names stay importable
+    # from here (chain.pulse_table, older scripts and tests), loaded on first use.
+    if name in ("pulse_table", "PULSE_COLUMNS"):
+        from chain.analysis import pulse_rows
 
-    Sensor S1 is the first sensor column of ``traces``, S2 the last. Roles (see
-    ``docs/interfaces.md``): in a collision shot the 1st pulse at S1 is the incident
-    LSTW and the 2nd the crossed RSTW; at S2 the 1st is the incident RSTW and the 2nd
-    the crossed LSTW; a reference shot has one pulse per sensor, role ``reference``,
-    wave LSTW. A pulse that is not detected gives rows with ``ok`` False and reason
-    "no pulse detected"; when a collision signal shows one pulse only, it is taken as
-    the incident one.
-
-    Parameters
-    ----------
-    traces : DataFrame
-        A trace table (:mod:`chain.traces`).
-    estimators : sequence of str
-        Names from :data:`ESTIMATORS`.
-    rel_prominence, min_snr, min_height_N
-        Detection thresholds, as in :func:`find_pulses`.
-
-    Returns
-    -------
-    DataFrame
-        ``source, model, N, shot, kind, amplitude, sensor, bead, role, wave, estimator,
-        F_m_N, T_s, tau_s, F_m_stderr_N, T_stderr_s, tau_stderr_s, ok, reason``, then
-        ``baseline_N, noise_N, n_samples``.
-    """
-    estimators = tuple(estimators)
-    unknown = [e for e in estimators if e not in ESTIMATORS]
-    if unknown:
-        raise ParameterError(f"unknown estimators {unknown}; choose from {ESTIMATORS}")
-    beads = sensor_beads(traces)
-    sensors = [("S1", beads[0])] + ([("S2", beads[-1])] if len(beads) > 1 else [])
-    rows = []
-    for shot, meta, time, forces in iter_shots(traces):
-        for sensor, bead in sensors:
-            roles = _roles(meta["kind"], sensor)
-            force = forces[bead]
-            baseline, noise = estimate_baseline(time, force)
-            segments = find_pulses(
-                time,
-                force,
-                max_pulses=len(roles),
-                baseline_N=baseline,
-                noise_N=noise,
-                rel_prominence=rel_prominence,
-                min_snr=min_snr,
-                min_height_N=min_height_N,
-            )
-            for i, (role, wave) in enumerate(roles):
-                for estimator in estimators:
-                    if i < len(segments):
-                        part = segments[i].slice
-                        fit = fit_pulse(
-                            time[part],
-                            force[part],
-                            estimator,
-                            baseline_N=baseline,
-                            noise_N=noise,
-                        )
-                    else:
-                        found = f" ({len(segments)} of {len(roles)} found)" if segments else ""
-                        fit = PulseFit.failed("no pulse detected" + found)
-                    rows.append(
-                        {
-                            "source": meta["source"],
-                            "model": meta["model"],
-                            "N": int(meta["N"]),
-                            "shot": shot,
-                            "kind": meta["kind"],
-                            "amplitude": int(meta["amplitude"]),
-                            "sensor": sensor,
-                            "bead": bead,
-                            "role": role,
-                            "wave": wave,
-                            "estimator": estimator,
-                            **_fit_columns(fit),
-                            "baseline_N": baseline,
-                            "noise_N": noise,
-                        }
-                    )
-    return pd.DataFrame(rows, columns=PULSE_COLUMNS)
-
-
-#: Columns of :func:`pulse_table`, in order.
-PULSE_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "sensor",
-    "bead",
-    "role",
-    "wave",
-    "estimator",
-    "F_m_N",
-    "T_s",
-    "tau_s",
-    "F_m_stderr_N",
-    "T_stderr_s",
-    "tau_stderr_s",
-    "ok",
-    "reason",
-    "baseline_N",
-    "noise_N",
-    "n_samples",
-)
-
-
-def _roles(kind: str, sensor: str) -> list[tuple[str, str]]:
-    if kind == "reference":
-        return [("reference", "LSTW")]
-    if sensor == "S1":
-        return [("incident", "LSTW"), ("crossed", "RSTW")]
-    return [("incident", "RSTW"), ("crossed", "LSTW")]
-
-
-def _fit_columns(fit: PulseFit) -> dict:
-    values = asdict(fit)
-    return {
-        "F_m_N": values["peak_force"],
-        "T_s": values["arrival_time"],
-        "tau_s": values["tau"],
-        "F_m_stderr_N": values["peak_force_stderr"],
-        "T_stderr_s": values["arrival_time_stderr"],
-        "tau_stderr_s": values["tau_stderr"],
-        "ok": values["ok"],
-        "reason": values["reason"],
-        "n_samples": values["n_samples"],
-    }
+        return getattr(pulse_rows, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -5,7 +5,7 @@ greater than 5 %, it is considered that solitary waves have crossed at the middl
 chain ... Data for which this condition is not fulfilled are not retained."
 
 :func:`select_shots` applies it to the rows of ``pulses.csv``
-(:func:`chain.analysis.pulses.pulse_table`): a collision shot is kept when the incident
+(:func:`chain.analysis.pulse_rows.pulse_table`): a collision shot is kept when the incident
 amplitudes F_L (LSTW at S1) and F_R (RSTW at S2) satisfy
 
     mismatch = |F_L - F_R| / ((F_L + F_R) / 2) <= tolerance,
@@ -85,7 +85,7 @@ def select_shots(
     Parameters
     ----------
     pulses : DataFrame
-        Rows of ``pulses.csv`` (columns of :func:`chain.analysis.pulses.pulse_table`; needed:
+        Rows of ``pulses.csv`` (columns of :func:`chain.analysis.pulse_rows.pulse_table`; needed:
         source, model, N, shot, kind, amplitude, sensor, role, estimator, F_m_N, ok,
         and reason when present).
     tolerance : float
@@ -164,7 +164,7 @@ def _pulse(group: pd.DataFrame, sensor: str, role: str):
     if rows.empty:
         return None, f"no pulse detected ({label}: no row)"
     row = rows.iloc[0]
-    if not bool(row["ok"]):
+    if not is_ok(rows).iloc[0]:
         reason = str(row["reason"]) if "reason" in row and isinstance(row["reason"], str) else ""
         return None, f"{reason or 'fit failed'} ({label})"
     force = float(row["F_m_N"])

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from chain.errors import ParameterError, require_nonnegative, require_positive
+from chain.errors import ParameterError, require_int, require_nonnegative, require_positive
 
 #: Sensitivity of the paper's sensor, PCB 200B02 (Sec. III), mV/N.
 PCB_200B02_SENSITIVITY_MV_PER_N = 11.24
@@ -151,10 +151,23 @@ def adc_step(bits: int, range_V: float) -> float:
     range_V : float
         Half span (full scale), V.
     """
-    if isinstance(bits, bool) or not isinstance(bits, int | np.integer) or not 2 <= bits <= 32:
-        raise ParameterError(f"adc_bits must be an integer in 2..32, got {bits!r}")
+    bits = check_adc_bits(bits)
     range_V = require_positive("adc_range_V", range_V)
     return 2.0 * range_V / 2**bits
+
+
+def check_adc_bits(bits: int) -> int:
+    """``bits`` as an int, or :class:`ParameterError` naming ``adc_bits``.
+
+    Parameters
+    ----------
+    bits : int
+        ADC resolution, bits: an integer in 2..32.
+    """
+    bits = require_int("adc_bits", bits, 2)
+    if bits > 32:
+        raise ParameterError(f"adc_bits must be <= 32, got {bits}")
+    return bits
 
 
 def quantise(volts_V, bits: int, range_V: float):

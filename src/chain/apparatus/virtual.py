@@ -33,7 +33,6 @@ are written in the measured-trace format (:mod:`chain.apparatus.measured`), so
 
 from __future__ import annotations
 
-import itertools
 import math
 import os
 import shutil
@@ -50,6 +49,7 @@ import yaml
 from chain.apparatus.acquisition import (
     PCB_200B02_SENSITIVITY_MV_PER_N,
     add_noise,
+    check_adc_bits,
     newtons_to_volts,
     quantise,
     resample,
@@ -63,7 +63,13 @@ from chain.apparatus.measured import (
     write_shot_csv,
 )
 from chain.atomic import ordinary_mode, replace_folder, write_text_atomic
-from chain.errors import ParameterError, require_nonnegative, require_positive
+from chain.errors import (
+    ParameterError,
+    check_bead_numbers,
+    require_int,
+    require_nonnegative,
+    require_positive,
+)
 from chain.labels import VIRTUAL_LABEL
 from chain.physics.materials import Material, get_material
 from chain.physics.model import (
@@ -172,60 +178,35 @@ class VirtualExperiment:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        def setattr_(name, value):
-            object.__setattr__(self, name, value)
-
-        _require_int("n_beads", self.n_beads, 2)
-        beads = _int_tuple("sensor_beads", self.sensor_beads)
-        if not beads or any(not 1 <= b <= self.n_beads for b in beads):
-            raise ParameterError(
-                f"sensor_beads must be beads in 1..{self.n_beads}, got {list(beads)}"
-            )
-        if any(a >= b for a, b in itertools.pairwise(beads)):
-            raise ParameterError(f"sensor_beads must increase (S1 first), got {list(beads)}")
-        setattr_("sensor_beads", beads)
+        # Checked in field order; lists from a config become tuples (the dataclass is
+        # frozen, hence object.__setattr__).
+        require_int("n_beads", self.n_beads, 2)
+        beads = check_bead_numbers("sensor_beads", self.sensor_beads, self.n_beads)
+        object.__setattr__(self, "sensor_beads", beads)
         if not isinstance(self.material, Material):
             get_material(self.material)
         for name in ("radius", "striker_radius", "sensor_stiffness", "sampling_interval_s"):
             require_positive(name, getattr(self, name))
         for name in ("eta", "drag_rate", "timing_jitter_s", "noise_N"):
             require_nonnegative(name, getattr(self, name))
-        sensitivity = self.sensitivity_mV_per_N
-        if isinstance(sensitivity, Sequence) and not isinstance(sensitivity, str):
-            sensitivity = tuple(require_positive("sensitivity_mV_per_N", s) for s in sensitivity)
-            if len(sensitivity) != len(beads):
-                raise ParameterError(
-                    f"sensitivity_mV_per_N needs one value per sensor ({len(beads)}), "
-                    f"got {len(sensitivity)}"
-                )
-        else:
-            sensitivity = require_positive("sensitivity_mV_per_N", sensitivity)
-        setattr_("sensitivity_mV_per_N", sensitivity)
-        if self.impact_speeds_m_s is not None and self.drop_heights_m is not None:
-            raise ParameterError("give impact_speeds_m_s or drop_heights_m, not both")
-        for name in ("impact_speeds_m_s", "drop_heights_m"):
-            values = getattr(self, name)
-            if values is not None:
-                values = tuple(require_positive(name, v) for v in np.atleast_1d(values))
-                if not values:
-                    raise ParameterError(f"{name} must list at least one value")
-                setattr_(name, values)
-        _require_int("collision_shots", self.collision_shots, 1)
-        _require_int("reference_shots", self.reference_shots, 0)
+        sensitivity = _checked_sensitivity(self.sensitivity_mV_per_N, len(beads))
+        object.__setattr__(self, "sensitivity_mV_per_N", sensitivity)
+        for name, values in _checked_amplitudes(self.impact_speeds_m_s, self.drop_heights_m):
+            object.__setattr__(self, name, values)
+        require_int("collision_shots", self.collision_shots, 1)
+        require_int("reference_shots", self.reference_shots, 0)
         mismatch = require_nonnegative("speed_mismatch", self.speed_mismatch)
         if mismatch >= 0.5:
             raise ParameterError(f"speed_mismatch is a relative std < 0.5, got {mismatch}")
         if self.adc_bits is not None:
-            _require_int("adc_bits", self.adc_bits, 2)
-            if self.adc_bits > 32:
-                raise ParameterError(f"adc_bits must be <= 32, got {self.adc_bits}")
+            check_adc_bits(self.adc_bits)
         require_positive("adc_range_V", self.adc_range_V)
         duration = require_positive("duration_s", self.duration_s)
         if duration < 3 * self.sampling_interval_s:
             raise ParameterError("duration_s must cover at least 3 sampling intervals")
         if self.time_step_s is not None:
             require_positive("time_step_s", self.time_step_s)
-        _require_int("seed", self.seed, 0)
+        require_int("seed", self.seed, 0)
 
     @classmethod
     def from_dict(cls, mapping: Mapping) -> VirtualExperiment:
@@ -294,17 +275,36 @@ class VirtualExperiment:
         return np.array(DEFAULT_IMPACT_SPEEDS_M_S if speeds is None else speeds, dtype=float)
 
 
-def _require_int(name: str, value, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ParameterError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
+def _checked_sensitivity(sensitivity, n_sensors: int) -> float | tuple[float, ...]:
+    """``sensitivity_mV_per_N`` checked: one positive value (mV/N) for all sensors, or
+    a tuple of one per sensor."""
+    if isinstance(sensitivity, Sequence) and not isinstance(sensitivity, str):
+        sensitivity = tuple(require_positive("sensitivity_mV_per_N", s) for s in sensitivity)
+        if len(sensitivity) != n_sensors:
+            raise ParameterError(
+                f"sensitivity_mV_per_N needs one value per sensor ({n_sensors}), "
+                f"got {len(sensitivity)}"
+            )
+        return sensitivity
+    return require_positive("sensitivity_mV_per_N", sensitivity)
 
 
-def _int_tuple(name: str, values) -> tuple[int, ...]:
-    try:
-        return tuple(_require_int(name, v, 1) for v in values)
-    except TypeError:
-        raise ParameterError(f"{name} must be a list of bead numbers, got {values!r}") from None
+def _checked_amplitudes(impact_speeds_m_s, drop_heights_m) -> list[tuple[str, tuple]]:
+    """(field, tuple of positive values) of whichever of ``impact_speeds_m_s`` (m/s) and
+    ``drop_heights_m`` (m) is given; giving both is an error."""
+    if impact_speeds_m_s is not None and drop_heights_m is not None:
+        raise ParameterError("give impact_speeds_m_s or drop_heights_m, not both")
+    checked = []
+    for name, values in (
+        ("impact_speeds_m_s", impact_speeds_m_s),
+        ("drop_heights_m", drop_heights_m),
+    ):
+        if values is not None:
+            values = tuple(require_positive(name, v) for v in np.atleast_1d(values))
+            if not values:
+                raise ParameterError(f"{name} must list at least one value")
+            checked.append((name, values))
+    return checked
 
 
 def plan_shots(settings: VirtualExperiment) -> pd.DataFrame:

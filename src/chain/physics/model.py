@@ -24,7 +24,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from chain.errors import ParameterError, require_nonnegative, require_positive
+from chain.errors import (
+    ParameterError,
+    check_bead_numbers,
+    require_int,
+    require_nonnegative,
+    require_positive,
+)
 from chain.physics.materials import STEEL_100C6, Material, contact_stiffness, sphere_mass
 
 #: Link kinds.
@@ -138,9 +144,8 @@ class ChainModel:
 
     def bead_index(self, bead: int) -> int:
         """Zero-based array index of ``bead`` (1..N); raises naming the bead otherwise."""
-        if not isinstance(bead, int | np.integer) or not 1 <= bead <= self.n_beads:
-            raise ParameterError(f"bead must be an integer in 1..{self.n_beads}, got {bead!r}")
-        return int(bead) - 1
+        (number,) = check_bead_numbers("bead", [bead], self.n_beads)
+        return number - 1
 
 
 def build_chain(
@@ -178,6 +183,64 @@ def build_chain(
     drag_rate : float
         Linear track friction rate gamma, 1/s: every particle feels -m gamma v.
     """
+    masses, stiffness, etas, sensors = _check_chain_inputs(
+        bead_masses,
+        contact_stiffnesses,
+        eta,
+        sensor_beads,
+        sensor_stiffness,
+        walls=(left_wall_stiffness, right_wall_stiffness),
+        strikers=(left_striker, right_striker),
+        drag_rate=drag_rate,
+    )
+    parts = _Particles()
+    left_index = -1
+    if left_striker is not None:
+        left_index = parts.add_particle(left_striker.mass)
+        parts.add_link(HERTZ, left_striker.contact_stiffness, etas[0])
+    for number in range(1, len(masses) + 1):
+        if number > 1:
+            parts.contact_link.append(
+                parts.add_link(HERTZ, stiffness[number - 2], etas[number - 2])
+            )
+        parts.add_bead(masses[number - 1], sensor_stiffness if number in sensors else None)
+    right_index = -1
+    if right_striker is not None:
+        parts.add_link(HERTZ, right_striker.contact_stiffness, etas[-1])
+        right_index = parts.add_particle(right_striker.mass)
+    n_particles = len(parts.mass)
+    return ChainModel(
+        masses=np.array(parts.mass),
+        link_kind=np.array(parts.link_kind, dtype=np.int64),
+        link_stiffness=np.array(parts.link_stiffness),
+        link_eta=np.array(parts.link_eta),
+        wall_stiffness=np.array([left_wall_stiffness, right_wall_stiffness], dtype=float),
+        wall_eta=np.array([etas[0], etas[-1]], dtype=float),
+        drag_rate=np.full(n_particles, float(drag_rate)),
+        bead_first=np.array(parts.bead_first, dtype=np.int64),
+        bead_last=np.array(parts.bead_last, dtype=np.int64),
+        contact_link=np.array(parts.contact_link, dtype=np.int64),
+        sensor_beads=tuple(sorted(sensors)),
+        sensor_link=np.array([parts.sensor_link[b] for b in sorted(sensors)], dtype=np.int64),
+        left_striker=left_index,
+        right_striker=right_index,
+    )
+
+
+def _check_chain_inputs(
+    bead_masses,
+    contact_stiffnesses,
+    eta,
+    sensor_beads,
+    sensor_stiffness,
+    *,
+    walls: tuple[float, float],
+    strikers: tuple[Striker | None, Striker | None],
+    drag_rate: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+    """The inputs of :func:`build_chain` checked, as (masses kg, contact stiffnesses
+    N/m^(3/2), eta per contact s, sensor beads); raises :class:`ParameterError` naming
+    the first bad one."""
     masses = np.asarray(bead_masses, dtype=float)
     if masses.ndim != 1 or len(masses) < 2:
         raise ParameterError(f"bead_masses must list N >= 2 masses, got {len(masses)}")
@@ -194,76 +257,58 @@ def build_chain(
     etas = np.broadcast_to(np.asarray(eta, dtype=float), (n_beads - 1,)).copy()
     for number, value in enumerate(etas, start=1):
         require_nonnegative(f"eta[contact {number}]", value)
-    require_nonnegative("left_wall_stiffness", left_wall_stiffness)
-    require_nonnegative("right_wall_stiffness", right_wall_stiffness)
+    for side, wall, striker in zip(("left", "right"), walls, strikers):
+        require_nonnegative(f"{side}_wall_stiffness", wall)
+        if striker is not None and wall > 0:
+            raise ParameterError(f"{side}_striker: cannot combine a striker with a {side} wall")
     require_nonnegative("drag_rate", drag_rate)
-    sensors = tuple(int(b) for b in sensor_beads)
-    for bead in sensors:
-        if not 1 <= bead <= n_beads:
-            raise ParameterError(f"sensor_beads: bead {bead} is outside the chain 1..{n_beads}")
-    if len(set(sensors)) != len(sensors):
-        raise ParameterError(f"sensor_beads: duplicate bead in {list(sensors)}")
+    # Sensor beads may come in any order here (the model sorts them); S1-first order is
+    # a property of a recording, checked where sensors are read.
+    sensors = tuple(sensor_beads)
     if sensors:
+        sensors = check_bead_numbers("sensor_beads", sensors, n_beads, increasing=False)
         require_positive("sensor_stiffness", sensor_stiffness)
-    if left_striker is not None and left_wall_stiffness > 0:
-        raise ParameterError("left_striker: cannot combine a striker with a left wall")
-    if right_striker is not None and right_wall_stiffness > 0:
-        raise ParameterError("right_striker: cannot combine a striker with a right wall")
+    return masses, stiffness, etas, sensors
 
-    particle_mass: list[float] = []
-    link_kind: list[int] = []
-    link_stiffness: list[float] = []
-    link_eta: list[float] = []
-    bead_first: list[int] = []
-    bead_last: list[int] = []
-    contact_link: list[int] = []
-    sensor_link: dict[int, int] = {}
 
-    def add_link(kind: int, value: float, relaxation: float) -> int:
-        link_kind.append(kind)
-        link_stiffness.append(value)
-        link_eta.append(relaxation)
-        return len(link_kind) - 1
+class _Particles:
+    """The particle and link lists of a chain as :func:`build_chain` lays them out,
+    left to right."""
 
-    left_index = -1
-    if left_striker is not None:
-        particle_mass.append(left_striker.mass)
-        left_index = 0
-        add_link(HERTZ, left_striker.contact_stiffness, etas[0])
-    for number in range(1, n_beads + 1):
-        if number > 1:
-            contact_link.append(add_link(HERTZ, stiffness[number - 2], etas[number - 2]))
-        bead_first.append(len(particle_mass))
-        if number in sensors:
-            half = masses[number - 1] / 2.0
-            particle_mass.extend([half, half])
-            sensor_link[number] = add_link(SPRING, float(sensor_stiffness), 0.0)
+    def __init__(self) -> None:
+        self.mass: list[float] = []
+        self.link_kind: list[int] = []
+        self.link_stiffness: list[float] = []
+        self.link_eta: list[float] = []
+        self.bead_first: list[int] = []
+        self.bead_last: list[int] = []
+        self.contact_link: list[int] = []
+        self.sensor_link: dict[int, int] = {}
+
+    def add_particle(self, mass: float) -> int:
+        """Append a particle of ``mass`` (kg); its index."""
+        self.mass.append(mass)
+        return len(self.mass) - 1
+
+    def add_link(self, kind: int, value: float, relaxation: float) -> int:
+        """Append a link (HERTZ or SPRING, stiffness, eta s) to the right; its index."""
+        self.link_kind.append(kind)
+        self.link_stiffness.append(value)
+        self.link_eta.append(relaxation)
+        return len(self.link_kind) - 1
+
+    def add_bead(self, mass: float, sensor_stiffness: float | None) -> None:
+        """Append the next bead: one particle, or two halves joined by a spring of
+        ``sensor_stiffness`` (N/m) for a sensor bead."""
+        number = len(self.bead_first) + 1
+        self.bead_first.append(len(self.mass))
+        if sensor_stiffness is None:
+            self.add_particle(mass)
         else:
-            particle_mass.append(masses[number - 1])
-        bead_last.append(len(particle_mass) - 1)
-    right_index = -1
-    if right_striker is not None:
-        add_link(HERTZ, right_striker.contact_stiffness, etas[-1])
-        particle_mass.append(right_striker.mass)
-        right_index = len(particle_mass) - 1
-
-    n_particles = len(particle_mass)
-    return ChainModel(
-        masses=np.array(particle_mass),
-        link_kind=np.array(link_kind, dtype=np.int64),
-        link_stiffness=np.array(link_stiffness),
-        link_eta=np.array(link_eta),
-        wall_stiffness=np.array([left_wall_stiffness, right_wall_stiffness], dtype=float),
-        wall_eta=np.array([etas[0], etas[-1]], dtype=float),
-        drag_rate=np.full(n_particles, float(drag_rate)),
-        bead_first=np.array(bead_first, dtype=np.int64),
-        bead_last=np.array(bead_last, dtype=np.int64),
-        contact_link=np.array(contact_link, dtype=np.int64),
-        sensor_beads=tuple(sorted(sensors)),
-        sensor_link=np.array([sensor_link[b] for b in sorted(sensors)], dtype=np.int64),
-        left_striker=left_index,
-        right_striker=right_index,
-    )
+            self.add_particle(mass / 2.0)
+            self.add_particle(mass / 2.0)
+            self.sensor_link[number] = self.add_link(SPRING, float(sensor_stiffness), 0.0)
+        self.bead_last.append(len(self.mass) - 1)
 
 
 def uniform_chain(
@@ -305,8 +350,7 @@ def uniform_chain(
     drag_rate : float
         Linear track friction rate, 1/s.
     """
-    if not isinstance(n_beads, int | np.integer) or n_beads < 2:
-        raise ParameterError(f"n_beads must be an integer >= 2, got {n_beads!r}")
+    require_int("n_beads", n_beads, 2)
     radius = require_positive("radius", radius)
     if strikers not in ("both", "left", "right"):
         raise ParameterError(f"strikers must be 'both', 'left' or 'right', got {strikers!r}")

@@ -250,11 +250,10 @@ def ballistic_delay_constant_paper_first_line(material: Material, radius: float)
     """C_bal from the first line of Eq. 6 (2.94, mu = m) with V_m(F_m) from Eq. 5, s N^(1/6).
 
     A consistency check on the printed prefactor 0.7612: equal to
-    :func:`ballistic_delay_constant_paper` to the four digits printed.
+    :func:`ballistic_delay_constant_paper` to the four digits printed. Parameters as
+    in :func:`ballistic_delay_constant_paper` (material; bead radius R, m).
     """
-    mass = 4.0 / 3.0 * math.pi * radius**3 * material.density
-    kappa = 1.0 / (2.0 * material.theta * math.sqrt(2.0 / radius))
-    velocity_per_force = bead_velocity_from_force(1.0, material, radius)  # V_m at F_m = 1 N
+    mass, kappa, velocity_per_force = _ballistic_inputs(material, radius)
     time_scale = (5.0 * mass / (4.0 * kappa)) ** 0.4
     return PAPER_TIME_CONSTANT * time_scale * velocity_per_force ** (-0.2) * (1.0 - 2.0 ** (-0.2))
 
@@ -274,12 +273,20 @@ def ballistic_delay_constant_exact(material: Material, radius: float) -> float:
     radius : float
         Bead radius R, m.
     """
-    radius = require_positive("radius", radius)
-    mass = 4.0 / 3.0 * math.pi * radius**3 * material.density
-    kappa = 1.0 / (2.0 * material.theta * math.sqrt(2.0 / radius))
-    velocity = bead_velocity_from_force(1.0, material, radius)  # F_m = 1 N
+    mass, kappa, velocity = _ballistic_inputs(material, radius)
     return hertz_contact_time(mass, mass, kappa, velocity) - hertz_contact_time(
         mass, mass, kappa, 2.0 * velocity
+    )
+
+
+def _ballistic_inputs(material: Material, radius: float) -> tuple[float, float, float]:
+    """What the ballistic argument of Eq. 6 starts from: the bead mass m (kg), the
+    bead-bead contact stiffness kappa (N/m^(3/2)) and the peak bead velocity V_m of a
+    solitary wave of F_m = 1 N (m/s, Eq. 5)."""
+    return (
+        sphere_mass(material, radius),
+        contact_stiffness(material, radius, material, radius),
+        bead_velocity_from_force(1.0, material, radius),
     )
 
 

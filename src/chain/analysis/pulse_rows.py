@@ -1,0 +1,185 @@
+"""The rows of ``pulses.csv``: every main pulse of every shot of a trace table.
+
+Each sensor signal of each shot is split into its main pulses
+(:func:`chain.analysis.pulses.find_pulses`) and every pulse is measured with each asked
+estimator (:func:`chain.analysis.pulses.fit_pulse`). Sensor S1 is the first sensor
+column of the trace table, S2 the last. Roles (see ``docs/interfaces.md``): in a
+collision shot the 1st pulse at S1 is the incident LSTW and the 2nd the crossed RSTW; at
+S2 the 1st is the incident RSTW and the 2nd the crossed LSTW; a reference shot has one
+pulse per sensor, role ``reference``, wave LSTW.
+
+SI units inside; table columns carry their unit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+
+import numpy as np
+import pandas as pd
+
+from chain.analysis.pulses import (
+    DEFAULT_MIN_SNR,
+    DEFAULT_REL_PROMINENCE,
+    ESTIMATORS,
+    PulseFit,
+    estimate_baseline,
+    find_pulses,
+    fit_pulse,
+)
+from chain.errors import ParameterError
+from chain.traces import iter_shots, sensor_beads
+
+#: Columns of :func:`pulse_table`, in order.
+PULSE_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "shot",
+    "kind",
+    "amplitude",
+    "sensor",
+    "bead",
+    "role",
+    "wave",
+    "estimator",
+    "F_m_N",
+    "T_s",
+    "tau_s",
+    "F_m_stderr_N",
+    "T_stderr_s",
+    "tau_stderr_s",
+    "ok",
+    "reason",
+    "baseline_N",
+    "noise_N",
+    "n_samples",
+)
+
+
+def pulse_table(
+    traces: pd.DataFrame,
+    estimators=("fit_full",),
+    *,
+    rel_prominence: float = DEFAULT_REL_PROMINENCE,
+    min_snr: float = DEFAULT_MIN_SNR,
+    min_height_N: float = 0.0,
+) -> pd.DataFrame:
+    """The rows of ``pulses.csv``: every main pulse of every shot, per estimator.
+
+    Roles as in the module docstring. A pulse that is not detected gives rows with
+    ``ok`` False and reason "no pulse detected"; when a collision signal shows one
+    pulse only, it is taken as the incident one.
+
+    Parameters
+    ----------
+    traces : DataFrame
+        A trace table (:mod:`chain.traces`).
+    estimators : sequence of str
+        Names from :data:`chain.analysis.pulses.ESTIMATORS`.
+    rel_prominence, min_snr, min_height_N
+        Detection thresholds, as in :func:`chain.analysis.pulses.find_pulses`
+        (fractions, noise standard deviations, N).
+
+    Returns
+    -------
+    DataFrame
+        ``source, model, N, shot, kind, amplitude, sensor, bead, role, wave, estimator,
+        F_m_N, T_s, tau_s, F_m_stderr_N, T_stderr_s, tau_stderr_s, ok, reason``, then
+        ``baseline_N, noise_N, n_samples``.
+    """
+    estimators = tuple(estimators)
+    unknown = [e for e in estimators if e not in ESTIMATORS]
+    if unknown:
+        raise ParameterError(f"unknown estimators {unknown}; choose from {ESTIMATORS}")
+    thresholds = {
+        "rel_prominence": rel_prominence,
+        "min_snr": min_snr,
+        "min_height_N": min_height_N,
+    }
+    beads = sensor_beads(traces)
+    sensors = [("S1", beads[0])] + ([("S2", beads[-1])] if len(beads) > 1 else [])
+    rows = []
+    for shot, meta, time, forces in iter_shots(traces):
+        shot_columns = {
+            "source": meta["source"],
+            "model": meta["model"],
+            "N": int(meta["N"]),
+            "shot": shot,
+            "kind": meta["kind"],
+            "amplitude": int(meta["amplitude"]),
+        }
+        for sensor, bead in sensors:
+            rows += _sensor_rows(
+                time,
+                forces[bead],
+                _roles(meta["kind"], sensor),
+                estimators,
+                thresholds,
+                {**shot_columns, "sensor": sensor, "bead": bead},
+            )
+    return pd.DataFrame(rows, columns=PULSE_COLUMNS)
+
+
+def _sensor_rows(
+    time: np.ndarray,
+    force: np.ndarray,
+    roles: list[tuple[str, str]],
+    estimators: tuple[str, ...],
+    thresholds: dict,
+    columns: dict,
+) -> list[dict]:
+    """The rows of one sensor signal of one shot: each expected pulse (``roles``, in
+    time order) measured with each estimator; ``columns`` are the shot and sensor ones."""
+    baseline, noise = estimate_baseline(time, force)
+    segments = find_pulses(
+        time, force, max_pulses=len(roles), baseline_N=baseline, noise_N=noise, **thresholds
+    )
+    rows = []
+    for i, (role, wave) in enumerate(roles):
+        for estimator in estimators:
+            if i < len(segments):
+                part = segments[i].slice
+                fit = fit_pulse(
+                    time[part], force[part], estimator, baseline_N=baseline, noise_N=noise
+                )
+            else:
+                found = f" ({len(segments)} of {len(roles)} found)" if segments else ""
+                fit = PulseFit.failed("no pulse detected" + found)
+            rows.append(
+                {
+                    **columns,
+                    "role": role,
+                    "wave": wave,
+                    "estimator": estimator,
+                    **_fit_columns(fit),
+                    "baseline_N": baseline,
+                    "noise_N": noise,
+                }
+            )
+    return rows
+
+
+def _roles(kind: str, sensor: str) -> list[tuple[str, str]]:
+    """(role, wave) of each pulse a sensor of a ``kind`` shot sees, in time order."""
+    if kind == "reference":
+        return [("reference", "LSTW")]
+    if sensor == "S1":
+        return [("incident", "LSTW"), ("crossed", "RSTW")]
+    return [("incident", "RSTW"), ("crossed", "LSTW")]
+
+
+def _fit_columns(fit: PulseFit) -> dict:
+    """A :class:`~chain.analysis.pulses.PulseFit` as ``pulses.csv`` columns."""
+    values = asdict(fit)
+    return {
+        "F_m_N": values["peak_force"],
+        "T_s": values["arrival_time"],
+        "tau_s": values["tau"],
+        "F_m_stderr_N": values["peak_force_stderr"],
+        "T_stderr_s": values["arrival_time_stderr"],
+        "tau_stderr_s": values["tau_stderr"],
+        "ok": values["ok"],
+        "reason": values["reason"],
+        "n_samples": values["n_samples"],
+    }
