@@ -46,7 +46,7 @@ __getattr__, __dir__, __all__ = lazy_exports(
         "get_material": "chain.physics.materials",
         "integrate": "chain.physics.integrator",
         "launch_velocities": "chain.physics.model",
-        "pulse_table": "chain.analysis.pulses",
+        "pulse_table": "chain.analysis.pulse_rows",
         "read_traces": "chain.traces",
         "simulate": "chain.physics.simulation",
         "simulate_shots": "chain.apparatus.shots",
