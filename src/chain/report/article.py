@@ -34,6 +34,7 @@ from chain.report.claims import (
     series_label,
     series_models,
 )
+from chain.report.paper import PAPER_ENERGY_DRIFT
 from chain.report.printed import fixed, percent, plus_minus, scientific, table_of
 
 #: Captions of the run's figures, by contract name (the article's own words).
@@ -55,10 +56,6 @@ CAPTIONS = {
     "amplitude against distance from the collision point.",
     "fig_parity_ssw_vs_N": "SSW slope against the number of beads, odd and even chains.",
 }
-
-#: The figures the article places in its sections, in order; any other figure of the
-#: run goes to a closing section.
-PLACED_FIGURES = tuple(CAPTIONS)
 
 
 def fit_rows(summary: Mapping) -> list[dict]:
@@ -197,14 +194,34 @@ def _dissipation_numbers(summary) -> list[dict]:
             "exponent": fixed(row.get("exponent"), 4),
             "base_exponent": fixed(reference.get("exponent"), 4),
             "loss": loss_text(summary, model),
+            "larger": row["C_us_N16"] > reference["C_us_N16"],
+            "flatter": (row.get("exponent") or -math.inf) > (reference.get("exponent") or math.inf),
         }
         for model, base, row, reference in dissipation_pairs(summary)
     ]
 
 
+def _between_ballistic(summary) -> bool:
+    """Whether every simulated C (main estimator, per chain) lies between the ballistic
+    C with the exact contact time and that of Eq. 6."""
+    low = summary["constants"]["C_bal_exact_us_N16"]
+    high = summary["constants"]["C_bal_paper_us_N16"]
+    low, high = min(low, high), max(low, high)
+    values = [
+        r["C_us_N16"]
+        for r in summary["delay_fits"]
+        if r["source"] == "simulation"
+        and r["N"] != "pooled"
+        and r["estimator"] == summary["main_estimator"]
+        and r.get("C_us_N16") is not None
+    ]
+    return bool(values) and all(low <= c <= high for c in values)
+
+
 def _constants_text(summary) -> dict:
     constants, paper = summary["constants"], summary["paper"]
     drift = scientific(summary.get("max_energy_drift"))
+    c_paper, c_exact = constants["C_bal_paper_us_N16"], constants["C_bal_exact_us_N16"]
     kappa = scientific(constants["kappa_N_m1_5"], 4)
     return {
         "run_name": summary["run_name"],
@@ -220,6 +237,9 @@ def _constants_text(summary) -> dict:
         "C_bal_recomputed": f"{constants['C_bal_paper_us_N16']:.2f}",
         "C_bal_exact": f"{constants['C_bal_exact_us_N16']:.2f}",
         "exact_over_printed": f"{constants['C_bal_exact_us_N16'] / paper['C_bal_us_N16']:.3f}",
+        "ballistic_gap": f"{abs(100 * (c_paper / c_exact - 1)):.0f} %",
+        "simulation_between_ballistic": _between_ballistic(summary),
+        "paper_drift": scientific(PAPER_ENERGY_DRIFT, 1),
         "mass_factor": f"{2.0**-0.4:.3f}",
         "time_constant": f"{HERTZ_TIME_CONSTANT:.3f}",
         "paper_time_constant": f"{PAPER_TIME_CONSTANT:.2f}",
@@ -321,8 +341,7 @@ def article_numbers(
 
 def figure_entries(paths: Iterable[str | os.PathLike], root: Path) -> list[dict]:
     """The run's figures for the article: ``name`` (file stem), ``path`` (from the typst
-    root, with a leading ``/``), ``caption`` and ``placed`` (shown in a section of its
-    own rather than among the further figures)."""
+    root, with a leading ``/``) and ``caption``."""
     out = []
     for path in paths:
         path = Path(path).resolve()
@@ -331,7 +350,6 @@ def figure_entries(paths: Iterable[str | os.PathLike], root: Path) -> list[dict]
                 "name": path.stem,
                 "path": "/" + path.relative_to(root).as_posix(),
                 "caption": CAPTIONS.get(path.stem, f"Figure {path.stem} of this run."),
-                "placed": path.stem in PLACED_FIGURES,
             }
         )
     return out
