@@ -219,3 +219,17 @@ def test_sign_and_ssw_claims_come_from_the_tables():
     table = verdicts(SUMMARY, delays=delays, ssw=ssw)
     assert table["Crossed waves come out early (a phase shift)"] == "no"
     assert table["SSW amplitude ∝ F_m (simulation, elastic)"] == "no"
+
+
+def test_a_run_without_experiment_says_so(tmp_path, figures):
+    summary = copy.deepcopy(SUMMARY)
+    for key in ("delay_fits", "ssw_fits"):
+        summary[key] = [r for r in summary[key] if r["source"] == "simulation"]
+    summary.update(experiment_label="experiment", selection=[], experiment_tolerance=None)
+    numbers = article_numbers(summary, setup={"source": "none"})
+    shown = {k: v for k, v in figures.items() if k != "fig2_experiment_traces"}
+    compile_article(SOURCE, numbers, list(shown.values()), tmp_path / "article.pdf")
+    text = pdf_text(tmp_path / "article.pdf")
+    assert "Thisrunhasnoexperimentside." in text
+    assert "Thisrunhasnoexperimentseries." in text
+    assert "virtualexperiment(model)" not in text

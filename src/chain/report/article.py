@@ -163,7 +163,7 @@ def _model_numbers(summary) -> list[dict]:
                     "C": plus_minus(main["C_us_N16"], main["C_stderr_us_N16"], 2),
                     "exponent": plus_minus(main.get("exponent"), main.get("exponent_stderr"), 4),
                     "per_N": per_n,
-                    "estimators": "; ".join(others),
+                    "estimators": ", ".join(others),
                     "loss": loss_text(summary, model) if source == "simulation" else None,
                 }
             )
