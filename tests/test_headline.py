@@ -102,6 +102,7 @@ def _write_run(folder, summary):
         )
     (folder / "summary.json").write_text(json.dumps(summary))
     (folder / "summary.md").write_text("# summary\n")
+    (folder / "article.pdf").write_bytes(b"%PDF-")
 
 
 def test_contract_check_names_missing_files_and_columns(tmp_path):
@@ -113,6 +114,8 @@ def test_contract_check_names_missing_files_and_columns(tmp_path):
     problems = headline.missing_contract_files(tmp_path)
     assert any("fig4_delay_vs_force.png" in p for p in problems)
     assert any("ssw_fits.csv" in p and "slope" in p for p in problems)
+    (tmp_path / "article.pdf").unlink()
+    assert any("article.pdf" in p for p in headline.missing_contract_files(tmp_path))
 
 
 def test_cli_check_exit_status(tmp_path, capsys):

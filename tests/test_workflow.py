@@ -223,6 +223,24 @@ def test_summary(tiny):
     assert "SSW slope, virtual experiment (model), N = 17" in text
 
 
+def test_article_embeds_every_figure_and_prints_the_fits(tiny):
+    """article.pdf (tests/test_article.py tests it closely on textless figures)."""
+    import pypdf
+
+    _, out, _, _ = tiny
+    reader = pypdf.PdfReader(out / "article.pdf")
+    forms = [
+        xobject.get_object()["/Subtype"]
+        for page in reader.pages
+        for xobject in page.get("/Resources", {}).get("/XObject", {}).values()
+    ]
+    assert forms == ["/Form"] * len(list((out / "figures").glob("*.pdf")))
+    text = "".join(page.extract_text() for page in reader.pages)
+    summary = json.loads((out / "summary.json").read_text())
+    for row in summary["delay_fits"]:
+        assert f"{row['C_us_N16']:.2f}" in text, row
+
+
 def test_second_run_has_nothing_to_do(tiny):
     work, _, env, _ = tiny
     assert planned_jobs(work, env) == {}

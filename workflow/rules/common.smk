@@ -188,4 +188,5 @@ def final_targets(wildcards=None):
         [f"{TABLES}/{table}.csv" for table in tables]
         + [path for name in figure_names() for path in figure(name)]
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
+        + [f"{OUT}/article.pdf"]
     )

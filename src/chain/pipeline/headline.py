@@ -79,7 +79,7 @@ def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = Tru
         absent = [c for c in columns if c not in header]
         if absent:
             problems.append(f"{path}: missing columns {absent}")
-    for name in ("summary.json", "summary.md"):
+    for name in ("summary.json", "summary.md", "article.pdf"):
         if not (folder / name).is_file():
             problems.append(f"{folder / name}: missing")
     if (folder / "summary.json").is_file():

@@ -1,0 +1,395 @@
+"""The reproduction as an article: ``results/<run_name>/article.pdf``.
+
+The article's text lives in a typst source (``workflow/report/article.typ``); every
+number in it comes from here. :func:`article_numbers` turns the run's ``summary.json``
+(and its delay and SSW tables) into one JSON-ready dict of strings, each number already
+rounded as the article prints it, the claim-by-claim table with its verdicts computed
+against the tolerances of :data:`TOLERANCES`, and the findings of the SSW and ablation
+studies (``None`` when the run did not compute them: the article then says so).
+:func:`compile_article` compiles the source with the ``typst`` package from PyPI.
+
+The paper's own numbers come from :mod:`chain.report.paper` via ``summary["paper"]``
+and are always printed as the paper's.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+import pandas as pd
+
+from chain.atomic import atomic_output
+from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
+from chain.report.claims import (
+    NOT_COMPUTED,
+    TOLERANCES,
+    claims,
+    dissipation_pairs,
+    fit_row,
+    loss_text,
+    series_label,
+    series_models,
+)
+from chain.report.paper import PAPER_ENERGY_DRIFT
+from chain.report.printed import fixed, percent, plus_minus, scientific, table_of
+
+#: Captions of the run's figures, by contract name (the article's own words).
+CAPTIONS = {
+    "fig1_setup": "The chain as configured for this run: beads, strikers, the two sensor "
+    "beads S1 and S2, and the left- and right-travelling waves (LSTW, RSTW).",
+    "fig2_experiment_traces": "Force at the two sensors in the experiment series of this "
+    "run, one column per chain: the left-launched wave solid, the right-launched dashed, "
+    "a reference wave that crossed nothing dotted.",
+    "fig3_simulation_traces": "The same from the simulation of Eq. 1, force felt by the "
+    "sensor beads (sensors not modelled), with the SSW marked where it is found.",
+    "fig4_delay_vs_force": "|Δ| against the incident amplitude F_m at the first sensor, "
+    "log-log: simulations, experiment series, the fits C F_m^(−1/6), the two ballistic "
+    "estimates, and the paper's C_exp quoted.",
+    "fig5_ssw_vs_force": "Amplitude of the secondary solitary wave against the incident "
+    "amplitude, per series and chain.",
+    "ssw_spacetime": "Contact force over contact index and time for one collision in an "
+    "odd and an even chain (log colour scale), with the tracked waves; beside it, the SSW "
+    "amplitude against distance from the collision point.",
+    "fig_parity_ssw_vs_N": "SSW slope against the number of beads, odd and even chains.",
+}
+
+
+def fit_rows(summary: Mapping) -> list[dict]:
+    """Every row of ``delay_fits``, printed: C ± stderr (2 decimals), exponent ± stderr
+    (4 decimals), points. The article's appendix table."""
+    order = {"fit_full": 0, "peak": 1, "fit_rise": 2}
+    rows = sorted(
+        summary["delay_fits"],
+        key=lambda r: (
+            r["source"] != "simulation",
+            r["model"],
+            r["N"] == "pooled",
+            str(r["N"]),
+            order.get(r["estimator"], 9),
+            r["estimator"],
+        ),
+    )
+    return [
+        {
+            "series": series_label(summary, r["source"], r["model"]),
+            "N": "pooled" if r["N"] == "pooled" else str(r["N"]),
+            "estimator": r["estimator"],
+            "C": plus_minus(r.get("C_us_N16"), r.get("C_stderr_us_N16"), 2),
+            "exponent": plus_minus(r.get("exponent"), r.get("exponent_stderr"), 4),
+            "points": str(r.get("n_points", "")),
+        }
+        for r in rows
+    ]
+
+
+def ssw_slope_rows(summary: Mapping) -> list[dict]:
+    """Every row of ``ssw_fits``, printed: slope ± stderr (4 decimals), points."""
+    return [
+        {
+            "series": series_label(summary, r["source"], r["model"]),
+            "N": str(r["N"]),
+            "slope": plus_minus(r.get("slope"), r.get("slope_stderr"), 4),
+            "points": str(r.get("n_points", "")),
+        }
+        for r in sorted(summary["ssw_fits"], key=lambda r: (r["source"], r["model"], str(r["N"])))
+    ]
+
+
+def findings(summary: Mapping) -> dict:
+    """The SSW, ablation and C-spread findings of the run, printed, or None each.
+
+    Reads the summary keys ``ssw_resolved``, ``ssw_separation``, ``ssw_parity_ratio``,
+    ``ablation`` ({verdict, rows}) and ``c_spread`` ({headline_choice, min_us_N16,
+    max_us_N16, rows}); an absent or empty key gives None.
+    """
+    resolved = summary.get("ssw_resolved") or None
+    ablation = summary.get("ablation") or None
+    spread = summary.get("c_spread") or None
+    return {
+        "ssw_resolved": table_of(resolved),
+        "ssw_resolved_count": None
+        if resolved is None
+        else {
+            "resolved": str(sum(bool(r.get("resolved")) for r in resolved)),
+            "total": str(len(resolved)),
+        },
+        "ssw_separation": table_of(summary.get("ssw_separation")),
+        "ssw_parity_ratio": table_of(summary.get("ssw_parity_ratio")),
+        "ablation": None
+        if ablation is None
+        else {"verdict": str(ablation.get("verdict", "")), "table": table_of(ablation.get("rows"))},
+        "c_spread": None
+        if spread is None
+        else {
+            "headline_choice": str(spread.get("headline_choice", "")),
+            "min": fixed(spread.get("min_us_N16"), 2),
+            "max": fixed(spread.get("max_us_N16"), 2),
+            "table": table_of(spread.get("rows")),
+        },
+    }
+
+
+def _model_numbers(summary) -> list[dict]:
+    """Per series (source, model): pooled C and exponent, per-N C, and how far the
+    other estimators' C lie from the main one's."""
+    out = []
+    for source in ("simulation", "experiment"):
+        for model in series_models(summary, source):
+            main = fit_row(summary, source, model, "pooled")
+            if main is None or main.get("C_us_N16") is None:
+                continue
+            others = [
+                f"{r['estimator']} {percent(r['C_us_N16'], main['C_us_N16'])}"
+                for r in summary["delay_fits"]
+                if (r["source"], r["model"], r["N"]) == (source, model, "pooled")
+                and r["estimator"] != main["estimator"]
+                and r.get("C_us_N16") is not None
+            ]
+            per_n = [
+                {"N": str(r["N"]), "C": plus_minus(r["C_us_N16"], r["C_stderr_us_N16"], 2)}
+                for r in summary["delay_fits"]
+                if (r["source"], r["model"], r["estimator"]) == (source, model, main["estimator"])
+                and r["N"] != "pooled"
+            ]
+            out.append(
+                {
+                    "source": source,
+                    "model": model,
+                    "who": series_label(summary, source, model),
+                    "C": plus_minus(main["C_us_N16"], main["C_stderr_us_N16"], 2),
+                    "exponent": plus_minus(main.get("exponent"), main.get("exponent_stderr"), 4),
+                    "per_N": per_n,
+                    "estimators": ", ".join(others),
+                    "loss": loss_text(summary, model) if source == "simulation" else None,
+                }
+            )
+    return out
+
+
+def _selection_text(summary) -> str | None:
+    """'N = 25: 17 of 24 collisions and 16 of 16 references kept; N = 26: ...'."""
+    counts = summary.get("selection") or []
+    parts = []
+    for n in dict.fromkeys(c["N"] for c in counts):
+        kinds = [
+            f"{c['kept']} of {c['kept'] + c['rejected']} {c['kind']}s"
+            for c in counts
+            if c["N"] == n
+        ]
+        parts.append(f"N = {n}: {' and '.join(kinds)} kept")
+    return "; ".join(parts) or None
+
+
+def _dissipation_numbers(summary) -> list[dict]:
+    """C and exponent of each dissipative model against each conservative one (pooled)."""
+    return [
+        {
+            "model": model,
+            "base": base,
+            "ratio": f"{row['C_us_N16'] / reference['C_us_N16']:.3f}",
+            "exponent": fixed(row.get("exponent"), 4),
+            "base_exponent": fixed(reference.get("exponent"), 4),
+            "loss": loss_text(summary, model),
+            "larger": row["C_us_N16"] > reference["C_us_N16"],
+            "flatter": (row.get("exponent") or -math.inf) > (reference.get("exponent") or math.inf),
+        }
+        for model, base, row, reference in dissipation_pairs(summary)
+    ]
+
+
+def _between_ballistic(summary) -> bool:
+    """Whether every simulated C (main estimator, per chain) lies between the ballistic
+    C with the exact contact time and that of Eq. 6."""
+    low = summary["constants"]["C_bal_exact_us_N16"]
+    high = summary["constants"]["C_bal_paper_us_N16"]
+    low, high = min(low, high), max(low, high)
+    values = [
+        r["C_us_N16"]
+        for r in summary["delay_fits"]
+        if r["source"] == "simulation"
+        and r["N"] != "pooled"
+        and r["estimator"] == summary["main_estimator"]
+        and r.get("C_us_N16") is not None
+    ]
+    return bool(values) and all(low <= c <= high for c in values)
+
+
+def _constants_text(summary) -> dict:
+    constants, paper = summary["constants"], summary["paper"]
+    drift = scientific(summary.get("max_energy_drift"))
+    c_paper, c_exact = constants["C_bal_paper_us_N16"], constants["C_bal_exact_us_N16"]
+    kappa = scientific(constants["kappa_N_m1_5"], 4)
+    return {
+        "run_name": summary["run_name"],
+        "material": summary["material"],
+        "radius_mm": f"{summary['radius_m'] * 1e3:g}",
+        "kappa": kappa,
+        "mass_g": f"{constants['bead_mass_kg'] * 1e3:.1f}",
+        "estimator": summary["main_estimator"],
+        "experiment_label": summary.get("experiment_label", "experiment"),
+        "virtual": "virtual" in summary.get("experiment_label", ""),
+        "has_experiment": bool(series_models(summary, "experiment")),
+        "C_bal_printed": f"{paper['C_bal_us_N16']:.2f}",
+        "C_bal_recomputed": f"{constants['C_bal_paper_us_N16']:.2f}",
+        "C_bal_exact": f"{constants['C_bal_exact_us_N16']:.2f}",
+        "exact_over_printed": f"{constants['C_bal_exact_us_N16'] / paper['C_bal_us_N16']:.3f}",
+        "ballistic_gap": f"{abs(100 * (c_paper / c_exact - 1)):.0f} %",
+        "simulation_between_ballistic": _between_ballistic(summary),
+        "paper_drift": scientific(PAPER_ENERGY_DRIFT, 1),
+        "mass_factor": f"{2.0**-0.4:.3f}",
+        "time_constant": f"{HERTZ_TIME_CONSTANT:.3f}",
+        "paper_time_constant": f"{PAPER_TIME_CONSTANT:.2f}",
+        "C_exp": f"{paper['C_exp_us_N16']:.1f} ± {paper['C_exp_err_us_N16']:.1f}",
+        "drift": drift,
+        "selection": _selection_text(summary),
+        "tolerances": {
+            "C": f"{100 * TOLERANCES['C']:g} %",
+            "C_bal_recomputed": f"{100 * TOLERANCES['C_bal_recomputed']:g} %",
+            "delay_exponent": f"{TOLERANCES['delay_exponent']:g}",
+            "dissipation_ratio": f"{100 * TOLERANCES['dissipation_ratio']:g} %",
+            "ssw_exponent": f"{TOLERANCES['ssw_exponent']:g}",
+        },
+    }
+
+
+def setup_text(setup: Mapping | None) -> dict:
+    """The run's configuration as printed: chains and sensors, models and η, launch
+    speeds, and the virtual experiment's apparatus (all optional keys)."""
+    setup = setup or {}
+    virtual = setup.get("virtual") or {}
+    speeds = virtual.get("impact_speeds_m_s") or []
+    launch = setup.get("launch") or {}
+    return {
+        "chains": [
+            {"N": str(c["N"]), "S1": str(c["sensors"][0]), "S2": str(c["sensors"][1])}
+            for c in setup.get("chains", [])
+        ],
+        "models": [
+            {"name": m["name"], "eta_us": f"{m['eta_s'] * 1e6:g}"} for m in setup.get("models", [])
+        ],
+        "launch": None
+        if not launch
+        else {
+            "count": str(launch["count"]),
+            "min": f"{launch['v0_min_m_s']:g}",
+            "max": f"{launch['v0_max_m_s']:g}",
+        },
+        "source": setup.get("source"),
+        "virtual": None
+        if not virtual
+        else {
+            "striker_mm": f"{setup.get('striker_radius_m', math.nan) * 1e3:g}",
+            "speeds": f"{min(speeds):g} to {max(speeds):g}" if speeds else "n/a",
+            "amplitudes": str(len(speeds)),
+            "collisions": str(virtual.get("collision_shots", "")),
+            "references": str(virtual.get("reference_shots", "")),
+            "noise_N": f"{virtual.get('noise_N', math.nan):g}",
+            "adc_bits": str(virtual.get("adc_bits", "")),
+            "mismatch_percent": f"{100 * virtual.get('speed_mismatch', math.nan):g}",
+            "jitter_us": f"{virtual.get('timing_jitter_s', math.nan) * 1e6:g}",
+            "sampling_us": f"{virtual.get('sampling_interval_s', math.nan) * 1e6:g}",
+            "eta_us": f"{virtual.get('eta_s', math.nan) * 1e6:g}",
+        },
+        "tolerance_percent": f"{100 * setup['tolerance']:g}" if setup.get("tolerance") else None,
+    }
+
+
+def article_numbers(
+    summary: Mapping,
+    delays: pd.DataFrame | None = None,
+    ssw: pd.DataFrame | None = None,
+    setup: Mapping | None = None,
+) -> dict:
+    """Everything the article prints, as strings: the JSON that article.typ reads.
+
+    Parameters
+    ----------
+    summary : mapping
+        The run's ``summary.json``.
+    delays, ssw : DataFrame, optional
+        ``delays.csv`` and ``ssw.csv`` of the run.
+    setup : mapping, optional
+        Plain configuration values: ``chains`` (N, sensors), ``models`` (name, eta_s in
+        s), ``launch`` (count, v0_min_m_s, v0_max_m_s in m/s), ``source`` (experiment
+        source), ``virtual`` (the virtual experiment's keys, SI), ``striker_radius_m``
+        (m) and ``tolerance`` (acceptance, fraction).
+
+    Returns
+    -------
+    dict
+        ``text`` (constants and labels), ``setup``, ``series`` (per source and model:
+        pooled C, exponent, per-N C, estimator spread, attenuation), ``claims``,
+        ``fits`` and ``ssw_slopes`` (every row, printed), ``findings`` (SSW, ablation,
+        C spread; None where not computed) and ``not_computed`` (the phrase for those).
+    """
+    return {
+        "text": _constants_text(summary),
+        "setup": setup_text(setup),
+        "series": _model_numbers(summary),
+        "dissipation": _dissipation_numbers(summary),
+        "claims": claims(summary, delays, ssw),
+        "fits": fit_rows(summary),
+        "ssw_slopes": ssw_slope_rows(summary),
+        "findings": findings(summary),
+        "not_computed": NOT_COMPUTED,
+    }
+
+
+def figure_entries(paths: Iterable[str | os.PathLike], root: Path) -> list[dict]:
+    """The run's figures for the article: ``name`` (file stem), ``path`` (from the typst
+    root, with a leading ``/``) and ``caption``."""
+    out = []
+    for path in paths:
+        path = Path(path).resolve()
+        out.append(
+            {
+                "name": path.stem,
+                "path": "/" + path.relative_to(root).as_posix(),
+                "caption": CAPTIONS.get(path.stem, f"Figure {path.stem} of this run."),
+            }
+        )
+    return out
+
+
+def compile_article(
+    source: str | os.PathLike,
+    numbers: Mapping,
+    figures: Iterable[str | os.PathLike],
+    output: str | os.PathLike,
+) -> None:
+    """Compile the typst ``source`` into the PDF ``output`` (atomically).
+
+    The numbers reach the source as ``sys.inputs.numbers`` (JSON, with the figure list
+    added under ``figures``); the figures are embedded as they are (PDF: vector). Only
+    the fonts bundled with typst are used, and the document date is left unset by the
+    source, so the same inputs give the same bytes on any machine.
+
+    Parameters
+    ----------
+    source : path
+        The typst source (``workflow/report/article.typ``).
+    numbers : mapping
+        :func:`article_numbers`.
+    figures : iterable of path
+        The figure files (PDF), in the order the article lists unplaced ones.
+    output : path
+        Destination PDF.
+    """
+    import typst  # here: a compiler the rest of the library does not need
+
+    source = Path(source).resolve()
+    figures = [Path(path).resolve() for path in figures]
+    root = Path(os.path.commonpath([source.parent, *figures]))
+    document = dict(numbers, figures=figure_entries(figures, root))
+    pdf = typst.compile(
+        str(source),
+        root=str(root),
+        sys_inputs={"numbers": json.dumps(document, sort_keys=True)},
+        ignore_system_fonts=True,
+    )
+    with atomic_output(output) as temporary:
+        Path(temporary).write_bytes(pdf)

@@ -1,0 +1,20 @@
+"""article.pdf: the reproduction as an article (chain.report.article + article.typ)."""
+
+import json
+
+import pandas as pd
+from _logging import start
+
+from chain.report.article import article_numbers, compile_article
+
+log = start(snakemake)
+with open(snakemake.input.summary, encoding="utf-8") as stream:
+    summary = json.load(stream)
+numbers = article_numbers(
+    summary,
+    delays=pd.read_csv(snakemake.input.delays),
+    ssw=pd.read_csv(snakemake.input.ssw),
+    setup=snakemake.params.setup,
+)
+compile_article(snakemake.input.source, numbers, snakemake.input.figures, snakemake.output[0])
+log.info("claims: %s", [(c["claim"], c["agrees"]) for c in numbers["claims"]])
