@@ -9,6 +9,7 @@ table look-ups that choose what to draw in :mod:`.picks`. Plot functions take an
 where they draw one axes, and compute nothing. ``summary.json`` is built in
 :mod:`.summary`, ``summary.md`` written in :mod:`.summary_md`; the paper's own numbers
 are in :mod:`.paper`, quoted as printed; the article's claims and their verdicts are in
-:mod:`.claims`, its numbers as printed in :mod:`.printed` and :mod:`.article`. A new figure is a new module here, a script in
-``workflow/scripts`` and a rule in ``workflow/rules/figures.smk``.
+:mod:`.claims`, its numbers as printed in :mod:`.printed` and :mod:`.article`. A new
+figure is a new module here, a script in ``workflow/scripts`` and a rule in
+``workflow/rules/figures.smk``.
 """
