@@ -11,13 +11,15 @@ dissipation, which makes the energy drift a check on the step in every run.
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from chain.errors import ParameterError, require_positive
 from chain.physics import reference_kernel
-from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_batch
+from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_one
 from chain.physics.model import HERTZ, SPRING, ChainModel
 
 #: Default bound on the relative energy drift before a run is declared broken.
@@ -215,6 +217,12 @@ def _lean_params(model: ChainModel) -> tuple:
         0, np.iinfo(np.uint64).max, size=n_links + 2, dtype=np.uint64, endpoint=True
     )
     springs = np.r_[np.flatnonzero(kind == SPRING), n_links].astype(np.int64)
+    walls = np.stack([model.wall_stiffness, 1.5 * model.wall_eta * model.wall_stiffness], axis=1)
+    drag = np.stack([model.drag_rate, model.masses * model.drag_rate], axis=1)
+    # None when absent, so that numba compiles a kernel without them.
+    walls = np.ascontiguousarray(walls) if np.any(model.wall_stiffness > 0) else None
+    drag = np.ascontiguousarray(drag) if np.any(model.drag_rate > 0) else None
+    damped = bool(np.any(damping[kind == HERTZ] > 0))
     return (
         1.0 / model.masses,
         np.ascontiguousarray(model.masses, dtype=float),
@@ -222,31 +230,36 @@ def _lean_params(model: ChainModel) -> tuple:
         damping,
         keys,
         springs,
-        np.ascontiguousarray(model.wall_stiffness, dtype=float),
-        1.5 * model.wall_eta * model.wall_stiffness,
-        np.ascontiguousarray(model.drag_rate, dtype=float),
+        walls,
+        drag,
         kind,
-        bool(np.any(damping[kind == HERTZ] > 0)),
-        bool(np.any(model.drag_rate > 0)),
+        damped,
     )
 
 
 def _run_lean(model: ChainModel, run, n_samples: int, links, particles):
     displacement, velocity, dt, n_steps, record_every = run
-    outputs = _outputs(velocity.shape[0], n_samples, len(links), len(particles))
-    report = _report(velocity.shape[0])
-    _integrate_batch(
-        displacement,
-        velocity,
-        _lean_params(model),
-        dt,
-        n_steps,
-        record_every,
-        links,
-        particles,
-        outputs,
-        *report,
-    )
+    batch = velocity.shape[0]
+    outputs = _outputs(batch, n_samples, len(links), len(particles))
+    status, fail_step, refined = report = _report(batch)
+    params = _lean_params(model)
+
+    def launch(b: int) -> None:
+        one = tuple(out[b] for out in outputs)
+        result = _integrate_one(
+            displacement[b], velocity[b], params, dt, n_steps, record_every, links, particles, one
+        )
+        status[b], fail_step[b], refined[b] = result
+
+    # Launches are independent and the kernel releases the GIL: one thread per core,
+    # each launch on one thread, so the results do not depend on the thread count.
+    workers = min(batch, numba.get_num_threads())
+    if workers == 1:
+        for b in range(batch):
+            launch(b)
+    else:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            list(pool.map(launch, range(batch)))
     return outputs, report
 
 

@@ -28,6 +28,8 @@ import math
 
 import numba
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 #: Status codes written by the kernels.
 _OK = 0
@@ -56,99 +58,129 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
     return elastic, total
 
 
-@numba.njit(cache=True, inline="always")
-def _walls(u, v, params):
-    """(left force, right force, dissipated power, closed walls, fingerprint) of the walls."""
-    wall_k, wall_c, keys = params[6], params[7], params[4]
+# The hot functions take the model's arrays one by one (taking them out of a tuple
+# costs reference-count updates at every call), and the right-hand side is one flat
+# loop over the links: a loop over runs of Hertz links between the sensor springs
+# made it 2.5x slower than the bare loop. Their shared trailing arguments
+# ``im, k, c, keys, springs, walls, drag, flags`` are the model (see _model).
+
+
+@numba.njit(cache=True)
+def _walls(u, v, keys, walls):
+    """(left force, right force, dissipated power, fingerprint) of the walls."""
     n = u.shape[0]
     power = 0.0
     left = 0.0
     right = 0.0
     mark = np.uint64(0)
-    if wall_k[0] > 0.0:
-        elastic, left = _hertz_force(wall_k[0], wall_c[0], -u[0], -v[0])
+    if walls[0, 0] > 0.0:
+        elastic, left = _hertz_force(walls[0, 0], walls[0, 1], -u[0], -v[0])
         power -= (left - elastic) * v[0]
         if u[0] < 0.0:
             mark ^= keys[keys.shape[0] - 2]
-    if wall_k[1] > 0.0:
-        elastic, right = _hertz_force(wall_k[1], wall_c[1], u[n - 1], v[n - 1])
+    if walls[1, 0] > 0.0:
+        elastic, right = _hertz_force(walls[1, 0], walls[1, 1], u[n - 1], v[n - 1])
         power += (right - elastic) * v[n - 1]
         if u[n - 1] > 0.0:
             mark ^= keys[keys.shape[0] - 1]
-    # Counted for free ends too, as the general kernel does.
-    closed = (u[0] < 0.0) + (u[n - 1] > 0.0)
-    return left, right, power, closed, mark
+    return left, right, power, mark
+
+
+def _wall_terms(u, v, keys, walls):
+    """_walls, or zeros when ``walls`` is None (decided when numba compiles)."""
+
+
+@overload(_wall_terms)
+def _wall_terms_overload(u, v, keys, walls):
+    if walls is types.none:
+        return lambda u, v, keys, walls: (0.0, 0.0, 0.0, np.uint64(0))
+    return lambda u, v, keys, walls: _walls(u, v, keys, walls)
+
+
+def _drag_terms(v, acc, drag, power):
+    """Track friction into ``acc``; returns the power with its dissipation added."""
+
+
+@overload(_drag_terms)
+def _drag_terms_overload(v, acc, drag, power):
+    if drag is types.none:
+        return lambda v, acc, drag, power: power
+    return lambda v, acc, drag, power: _drag(v, acc, drag, power)
+
+
+def _wall_energy(u, walls, energy):
+    """``energy`` plus the elastic energy of the wall contacts, J."""
+
+
+@overload(_wall_energy)
+def _wall_energy_overload(u, walls, energy):
+    if walls is types.none:
+        return lambda u, walls, energy: energy
+    return lambda u, walls, energy: _walls_energy(u, walls, energy)
+
+
+@numba.njit(cache=True)
+def _drag(v, acc, drag, power):
+    # drag[p] = (drag rate, mass x drag rate): the general kernel's m * g * v * v.
+    for p in range(v.shape[0]):
+        acc[p] -= drag[p, 0] * v[p]
+        power += drag[p, 1] * v[p] * v[p]
+    return power
 
 
 @numba.njit(cache=True, inline="always")
-def _hertz_run(u, v, params, acc, start, stop, previous, power, closed, mark):
-    """Hertz links start..stop-1 (no spring among them); returns the running sums."""
-    inverse_mass, stiffness, damping, keys, damped = (
-        params[0],
-        params[2],
-        params[3],
-        params[4],
-        params[10],
-    )
-    for j in range(start, stop):
+def _slopes(u, v, acc, im, k, c, keys, springs, walls, drag, flags):
+    """Accelerations into ``acc``; returns (dissipated power, closed contacts, fingerprint).
+
+    ``springs`` lists the bonded links in order and ends with n - 1 (no link);
+    ``walls`` and ``drag`` are None when the model has none: numba then compiles a
+    version without them (a branch on a flag made the loop 2x slower)."""
+    damped = flags
+    n = u.shape[0]
+    left = right = power = 0.0
+    mark = np.uint64(0)
+    left, right, power, mark = _wall_terms(u, v, keys, walls)
+    # Wall ends counted for free ends too, as the general kernel does.
+    closed = 0
+    if u[0] < 0.0:
+        closed += 1
+    if u[n - 1] > 0.0:
+        closed += 1
+    previous = left
+    spring = springs[0]
+    s = 0
+    for j in range(n - 1):
         delta = u[j] - u[j + 1]
         total = 0.0
-        if delta > 0.0:
+        if j == spring:
+            total = k[j] * delta
+            s += 1
+            spring = springs[s]
+        elif delta > 0.0:
             closed += 1
             mark ^= keys[j]
             if damped:
                 rate = v[j] - v[j + 1]
-                elastic, total = _hertz_force(stiffness[j], damping[j], delta, rate)
+                elastic, total = _hertz_force(k[j], c[j], delta, rate)
                 power += (total - elastic) * rate
             else:
-                total = stiffness[j] * delta * math.sqrt(delta)
-        acc[j] = (previous - total) * inverse_mass[j]
+                total = k[j] * delta * math.sqrt(delta)
+        acc[j] = (previous - total) * im[j]
         previous = total
-    return previous, power, closed, mark
-
-
-@numba.njit(cache=True, inline="always")
-def _slopes(u, v, params, acc):
-    """Accelerations into ``acc``; returns (dissipated power, closed contacts, fingerprint)."""
-    inverse_mass, masses, stiffness, springs, drag_rate, has_drag = (
-        params[0],
-        params[1],
-        params[2],
-        params[5],
-        params[8],
-        params[11],
-    )
-    n = u.shape[0]
-    left, right, power, closed, mark = _walls(u, v, params)
-    previous = left
-    start = 0
-    # springs lists the bonded links in order and ends with n - 1 (no link).
-    for s in range(springs.shape[0]):
-        stop = springs[s]
-        previous, power, closed, mark = _hertz_run(
-            u, v, params, acc, start, stop, previous, power, closed, mark
-        )
-        if stop < n - 1:
-            total = stiffness[stop] * (u[stop] - u[stop + 1])
-            acc[stop] = (previous - total) * inverse_mass[stop]
-            previous = total
-        start = stop + 1
-    acc[n - 1] = (previous - right) * inverse_mass[n - 1]
-    if has_drag:
-        for p in range(n):
-            acc[p] -= drag_rate[p] * v[p]
-            power += masses[p] * drag_rate[p] * v[p] * v[p]
+    acc[n - 1] = (previous - right) * im[n - 1]
+    power = _drag_terms(v, acc, drag, power)
     return power, closed, mark
 
 
 @numba.njit(cache=True, inline="always")
-def _rk4(u, v, acc0, power0, closed0, dt, params, work, u_out, v_out):
-    """One RK4 step from (u, v), whose slopes ``acc0`` are known, into (u_out, v_out).
+def _rk4(u, v, acc0, slope0, dt, buffers, im, k, c, keys, springs, walls, drag, flags):
+    """One RK4 step from (u, v), whose slopes ``acc0`` and ``slope0`` (power, closed,
+    fingerprint) are known, into (u_out, v_out), the last two ``buffers``.
 
     Returns the dissipated energy of the step and whether the number of closed
     contacts varied between the stages. The weighted slopes are summed as they come,
     in the general kernel's order (0.0 + 1 k1 + 2 k2 + 2 k3 + 1 k4)."""
-    acc, u_stage, v_stage, u_sum, v_sum = work
+    acc, u_stage, v_stage, u_sum, v_sum, u_out, v_out = buffers
     n = u.shape[0]
     half = 0.5 * dt
     for p in range(n):
@@ -156,11 +188,15 @@ def _rk4(u, v, acc0, power0, closed0, dt, params, work, u_out, v_out):
         v_sum[p] = 0.0 + acc0[p]
         u_stage[p] = u[p] + half * v[p]
         v_stage[p] = v[p] + half * acc0[p]
-    power_sum = 0.0 + power0
+    power_sum = 0.0 + slope0[0]
     varied = False
-    for stage in range(1, 3):
-        power, closed, _ = _slopes(u_stage, v_stage, params, acc)
-        varied = varied or closed != closed0
+    for stage in range(1, 4):
+        power, closed, _ = _slopes(
+            u_stage, v_stage, acc, im, k, c, keys, springs, walls, drag, flags
+        )
+        varied = varied or closed != slope0[1]
+        if stage == 3:
+            break
         power_sum += 2.0 * power
         h = dt if stage == 2 else half
         for p in range(n):
@@ -168,8 +204,6 @@ def _rk4(u, v, acc0, power0, closed0, dt, params, work, u_out, v_out):
             v_sum[p] += 2.0 * acc[p]
             u_stage[p] = u[p] + h * v_stage[p]
             v_stage[p] = v[p] + h * acc[p]
-    power, closed, _ = _slopes(u_stage, v_stage, params, acc)
-    varied = varied or closed != closed0
     power_sum += power
     sixth = dt / 6.0
     for p in range(n):
@@ -179,42 +213,19 @@ def _rk4(u, v, acc0, power0, closed0, dt, params, work, u_out, v_out):
 
 
 @numba.njit(cache=True)
-def _substeps(u, v, acc, slope, params, dt, work, spare):
-    """EVENT_SUBSTEPS RK4 steps from (u, v, acc) whose first-stage results are
-    ``slope`` = (power, closed, fingerprint); the end state is written back into
-    (u, v, acc). Returns (dissipated energy, event seen, end slope)."""
-    u_b, v_b, acc_b = spare
-    h = dt / EVENT_SUBSTEPS
-    increment = 0.0
-    event = False
-    for _ in range(EVENT_SUBSTEPS):
-        part, varied = _rk4(u, v, acc, slope[0], slope[1], h, params, work, u_b, v_b)
-        slope = _slopes(u_b, v_b, params, acc_b)
-        increment += part
-        event = event or varied
-        u, u_b = u_b, u
-        v, v_b = v_b, v
-        acc, acc_b = acc_b, acc
-    if EVENT_SUBSTEPS % 2 == 1:  # the end state is in the spare buffers
-        u_b[:] = u
-        v_b[:] = v
-        acc_b[:] = acc
-    return increment, event, slope
-
-
-@numba.njit(cache=True)
-def _record(u, v, dissipated, params, links, particles, sample, outputs):
-    """Writes sample ``sample``; returns False when the state is not finite."""
+def _record(u, v, dissipated, model, links, particles, sample, outputs):
+    """Writes sample ``sample``; returns False when the state is not finite.
+    ``model`` = (masses, k, c, keys, walls, kind)."""
     out_link, out_wall, out_velocity, out_energy, out_momentum = outputs
-    masses, stiffness, damping, link_kind = params[1], params[2], params[3], params[9]
-    left, right, _, _, _ = _walls(u, v, params)
+    masses, k, c, keys, walls, kind = model
+    left, right, _, _ = _wall_terms(u, v, keys, walls)
     for i in range(links.shape[0]):
         j = links[i]
         delta = u[j] - u[j + 1]
-        if link_kind[j] == 1:
-            out_link[sample, i] = stiffness[j] * delta
+        if kind[j] == 1:
+            out_link[sample, i] = k[j] * delta
         else:
-            out_link[sample, i] = _hertz_force(stiffness[j], damping[j], delta, v[j] - v[j + 1])[1]
+            out_link[sample, i] = _hertz_force(k[j], c[j], delta, v[j] - v[j + 1])[1]
     for i in range(particles.shape[0]):
         out_velocity[sample, i] = v[particles[i]]
     kinetic = 0.0
@@ -227,64 +238,111 @@ def _record(u, v, dissipated, params, links, particles, sample, outputs):
     out_wall[sample, 0] = left
     out_wall[sample, 1] = right
     out_energy[sample, 0] = kinetic
-    out_energy[sample, 1] = _potential_energy(u, params)
+    out_energy[sample, 1] = _potential_energy(u, k, kind, walls)
     out_energy[sample, 2] = dissipated
     out_momentum[sample] = momentum
     return finite
 
 
 @numba.njit(cache=True)
-def _potential_energy(u, params):
-    stiffness, wall_k, link_kind = params[2], params[6], params[9]
+def _potential_energy(u, k, kind, walls):
     n = u.shape[0]
     energy = 0.0
     for j in range(n - 1):
         delta = u[j] - u[j + 1]
-        if link_kind[j] == 1:
-            energy += 0.5 * stiffness[j] * delta * delta
+        if kind[j] == 1:
+            energy += 0.5 * k[j] * delta * delta
         elif delta > 0.0:
-            energy += 0.4 * stiffness[j] * delta * delta * math.sqrt(delta)
-    if wall_k[0] > 0.0 and u[0] < 0.0:
+            energy += 0.4 * k[j] * delta * delta * math.sqrt(delta)
+    return _wall_energy(u, walls, energy)
+
+
+@numba.njit(cache=True)
+def _walls_energy(u, walls, energy):
+    n = u.shape[0]
+    if walls[0, 0] > 0.0 and u[0] < 0.0:
         delta = -u[0]
-        energy += 0.4 * wall_k[0] * delta * delta * math.sqrt(delta)
-    if wall_k[1] > 0.0 and u[n - 1] > 0.0:
+        energy += 0.4 * walls[0, 0] * delta * delta * math.sqrt(delta)
+    if walls[1, 0] > 0.0 and u[n - 1] > 0.0:
         delta = u[n - 1]
-        energy += 0.4 * wall_k[1] * delta * delta * math.sqrt(delta)
+        energy += 0.4 * walls[1, 0] * delta * delta * math.sqrt(delta)
     return energy
 
 
 @numba.njit(cache=True)
+def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag, flags):
+    """EVENT_SUBSTEPS RK4 steps from the state x = (u, v, spare u, spare v) whose
+    slopes are (``acc``, ``slope``); the end state is left in x[0], x[1] and ``acc``.
+    Returns (dissipated energy, event seen, end slope)."""
+    u, v, u_b, v_b = x
+    acc_b = work[5]
+    h = dt / EVENT_SUBSTEPS
+    increment = 0.0
+    event = False
+    for _ in range(EVENT_SUBSTEPS):
+        buffers = (work[0], work[1], work[2], work[3], work[4], u_b, v_b)
+        part, varied = _rk4(
+            u, v, acc, slope, h, buffers, im, k, c, keys, springs, walls, drag, flags
+        )
+        slope = _slopes(u_b, v_b, acc_b, im, k, c, keys, springs, walls, drag, flags)
+        increment += part
+        event = event or varied
+        u, u_b = u_b, u
+        v, v_b = v_b, v
+        acc, acc_b = acc_b, acc
+    if EVENT_SUBSTEPS % 2 == 1:  # the end state is in the spare buffers
+        u_b[:] = u
+        v_b[:] = v
+        acc_b[:] = acc
+    return increment, event, slope
+
+
+@numba.njit(cache=True, nogil=True)
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
     """RK4 for one launch; ``u`` and ``v`` end as the final state. Returns the status,
     the step at which it was set, and the number of steps refined at contact events."""
+    im, masses, k, c, keys, springs, walls, drag, kind, flags = params
+    # Unpacked once: a tuple holding None gives wrong elements inside some callees.
+    recorded = (masses, k, c, keys, walls, kind)
     n = u.shape[0]
-    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
-    spare = (np.empty(n), np.empty(n), np.empty(n))
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
     x_u, x_v, x_acc = u.copy(), v.copy(), np.empty(n)
-    slope = _slopes(x_u, x_v, params, x_acc)
+    y_u, y_v, y_acc = np.empty(n), np.empty(n), np.empty(n)
+    slope = _slopes(x_u, x_v, x_acc, im, k, c, keys, springs, walls, drag, flags)
     dissipated = 0.0
-    _record(x_u, x_v, dissipated, params, links, particles, 0, outputs)
-    refine = 0
-    refined = 0
+    _record(x_u, x_v, dissipated, recorded, links, particles, 0, outputs)
+    refine = refined = step = 0
     status = _OK
-    step = 0
     while step < n_steps and status == _OK:
         step += 1
         event = refine > 0
         if not event:
-            u_b, v_b, acc_b = spare
+            buffers = (work[0], work[1], work[2], work[3], work[4], y_u, y_v)
             increment, varied = _rk4(
-                x_u, x_v, x_acc, slope[0], slope[1], dt, params, work, u_b, v_b
+                x_u, x_v, x_acc, slope, dt, buffers, im, k, c, keys, springs, walls, drag, flags
             )
-            end = _slopes(u_b, v_b, params, acc_b)
+            end = _slopes(y_u, y_v, y_acc, im, k, c, keys, springs, walls, drag, flags)
             event = varied or end[2] != slope[2]
             if event:
                 refine = EVENT_AFTERMATH + 1
             else:
-                spare = (x_u, x_v, x_acc)
-                x_u, x_v, x_acc = u_b, v_b, acc_b
+                x_u, y_u, x_v, y_v, x_acc, y_acc = y_u, x_u, y_v, x_v, y_acc, x_acc
         if event:
-            increment, varied, end = _substeps(x_u, x_v, x_acc, slope, params, dt, work, spare)
+            increment, varied, end = _substeps(
+                (x_u, x_v, y_u, y_v),
+                x_acc,
+                slope,
+                dt,
+                work,
+                im,
+                k,
+                c,
+                keys,
+                springs,
+                walls,
+                drag,
+                flags,
+            )
             refine -= 1
             refined += 1
             if varied or end[2] != slope[2]:
@@ -293,27 +351,10 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
         dissipated += increment
         if step % record_every == 0:
             sample = step // record_every
-            if not _record(x_u, x_v, dissipated, params, links, particles, sample, outputs):
+            if not _record(x_u, x_v, dissipated, recorded, links, particles, sample, outputs):
                 status = _NOT_FINITE
     if status == _OK and not (np.all(np.isfinite(x_u)) and np.all(np.isfinite(x_v))):
         status = _NOT_FINITE
     u[:] = x_u
     v[:] = x_v
     return status, step, refined
-
-
-@numba.njit(cache=True, parallel=True)
-def _integrate_batch(
-    u, v, params, dt, n_steps, record_every, links, particles, outputs, status, fail_step, refined
-):
-    # Launches are independent: one thread each, so results do not depend on the
-    # number of threads.
-    out_link, out_wall, out_velocity, out_energy, out_momentum = outputs
-    for b in numba.prange(u.shape[0]):
-        one = (out_link[b], out_wall[b], out_velocity[b], out_energy[b], out_momentum[b])
-        result = _integrate_one(
-            u[b], v[b], params, dt, n_steps, record_every, links, particles, one
-        )
-        status[b] = result[0]
-        fail_step[b] = result[1]
-        refined[b] = result[2]
