@@ -222,7 +222,7 @@ def _lean_params(model: ChainModel) -> tuple:
     # None when absent, so that numba compiles a kernel without them.
     walls = np.ascontiguousarray(walls) if np.any(model.wall_stiffness > 0) else None
     drag = np.ascontiguousarray(drag) if np.any(model.drag_rate > 0) else None
-    damped = bool(np.any(damping[kind == HERTZ] > 0))
+    damped = damping if np.any(damping[kind == HERTZ] > 0) else None
     return (
         1.0 / model.masses,
         np.ascontiguousarray(model.masses, dtype=float),

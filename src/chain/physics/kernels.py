@@ -62,7 +62,8 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
 # costs reference-count updates at every call), and the right-hand side is one flat
 # loop over the links: a loop over runs of Hertz links between the sensor springs
 # made it 2.5x slower than the bare loop. Their shared trailing arguments
-# ``im, k, c, keys, springs, walls, drag, flags`` are the model (see _model).
+# ``im, k, c, keys, springs, walls, drag`` are the model (see _integrate_one); ``c``,
+# ``walls`` and ``drag`` are None when the model has no such term.
 
 
 @numba.njit(cache=True)
@@ -97,6 +98,25 @@ def _wall_terms_overload(u, v, keys, walls):
     return lambda u, v, keys, walls: _walls(u, v, keys, walls)
 
 
+def _hertz_link(k, c, j, delta, v, power):
+    """(force, power) of the closed Hertz link j: elastic when ``c`` is None, else with
+    the Kuwabara-Kono term, its dissipated power added (decided when numba compiles)."""
+
+
+@overload(_hertz_link)
+def _hertz_link_overload(k, c, j, delta, v, power):
+    if c is types.none:
+        return lambda k, c, j, delta, v, power: (k[j] * delta * math.sqrt(delta), power)
+    return lambda k, c, j, delta, v, power: _damped_link(k, c, j, delta, v, power)
+
+
+@numba.njit(cache=True)
+def _damped_link(k, c, j, delta, v, power):
+    rate = v[j] - v[j + 1]
+    elastic, total = _hertz_force(k[j], c[j], delta, rate)
+    return total, power + (total - elastic) * rate
+
+
 def _drag_terms(v, acc, drag, power):
     """Track friction into ``acc``; returns the power with its dissipation added."""
 
@@ -129,13 +149,12 @@ def _drag(v, acc, drag, power):
 
 
 @numba.njit(cache=True, inline="always")
-def _slopes(u, v, acc, im, k, c, keys, springs, walls, drag, flags):
+def _slopes(u, v, acc, im, k, c, keys, springs, walls, drag):
     """Accelerations into ``acc``; returns (dissipated power, closed contacts, fingerprint).
 
     ``springs`` lists the bonded links in order and ends with n - 1 (no link);
     ``walls`` and ``drag`` are None when the model has none: numba then compiles a
     version without them (a branch on a flag made the loop 2x slower)."""
-    damped = flags
     n = u.shape[0]
     left = right = power = 0.0
     mark = np.uint64(0)
@@ -159,12 +178,7 @@ def _slopes(u, v, acc, im, k, c, keys, springs, walls, drag, flags):
         elif delta > 0.0:
             closed += 1
             mark ^= keys[j]
-            if damped:
-                rate = v[j] - v[j + 1]
-                elastic, total = _hertz_force(k[j], c[j], delta, rate)
-                power += (total - elastic) * rate
-            else:
-                total = k[j] * delta * math.sqrt(delta)
+            total, power = _hertz_link(k, c, j, delta, v, power)
         acc[j] = (previous - total) * im[j]
         previous = total
     acc[n - 1] = (previous - right) * im[n - 1]
@@ -173,7 +187,7 @@ def _slopes(u, v, acc, im, k, c, keys, springs, walls, drag, flags):
 
 
 @numba.njit(cache=True, inline="always")
-def _rk4(u, v, acc0, slope0, dt, buffers, im, k, c, keys, springs, walls, drag, flags):
+def _rk4(u, v, acc0, slope0, dt, buffers, im, k, c, keys, springs, walls, drag):
     """One RK4 step from (u, v), whose slopes ``acc0`` and ``slope0`` (power, closed,
     fingerprint) are known, into (u_out, v_out), the last two ``buffers``.
 
@@ -191,9 +205,7 @@ def _rk4(u, v, acc0, slope0, dt, buffers, im, k, c, keys, springs, walls, drag, 
     power_sum = 0.0 + slope0[0]
     varied = False
     for stage in range(1, 4):
-        power, closed, _ = _slopes(
-            u_stage, v_stage, acc, im, k, c, keys, springs, walls, drag, flags
-        )
+        power, closed, _ = _slopes(u_stage, v_stage, acc, im, k, c, keys, springs, walls, drag)
         varied = varied or closed != slope0[1]
         if stage == 3:
             break
@@ -270,7 +282,7 @@ def _walls_energy(u, walls, energy):
 
 
 @numba.njit(cache=True)
-def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag, flags):
+def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag):
     """EVENT_SUBSTEPS RK4 steps from the state x = (u, v, spare u, spare v) whose
     slopes are (``acc``, ``slope``); the end state is left in x[0], x[1] and ``acc``.
     Returns (dissipated energy, event seen, end slope)."""
@@ -281,10 +293,8 @@ def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag, fla
     event = False
     for _ in range(EVENT_SUBSTEPS):
         buffers = (work[0], work[1], work[2], work[3], work[4], u_b, v_b)
-        part, varied = _rk4(
-            u, v, acc, slope, h, buffers, im, k, c, keys, springs, walls, drag, flags
-        )
-        slope = _slopes(u_b, v_b, acc_b, im, k, c, keys, springs, walls, drag, flags)
+        part, varied = _rk4(u, v, acc, slope, h, buffers, im, k, c, keys, springs, walls, drag)
+        slope = _slopes(u_b, v_b, acc_b, im, k, c, keys, springs, walls, drag)
         increment += part
         event = event or varied
         u, u_b = u_b, u
@@ -301,14 +311,14 @@ def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag, fla
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
     """RK4 for one launch; ``u`` and ``v`` end as the final state. Returns the status,
     the step at which it was set, and the number of steps refined at contact events."""
-    im, masses, k, c, keys, springs, walls, drag, kind, flags = params
+    im, masses, k, damping, keys, springs, walls, drag, kind, c = params
     # Unpacked once: a tuple holding None gives wrong elements inside some callees.
-    recorded = (masses, k, c, keys, walls, kind)
+    recorded = (masses, k, damping, keys, walls, kind)
     n = u.shape[0]
     work = (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
     x_u, x_v, x_acc = u.copy(), v.copy(), np.empty(n)
     y_u, y_v, y_acc = np.empty(n), np.empty(n), np.empty(n)
-    slope = _slopes(x_u, x_v, x_acc, im, k, c, keys, springs, walls, drag, flags)
+    slope = _slopes(x_u, x_v, x_acc, im, k, c, keys, springs, walls, drag)
     dissipated = 0.0
     _record(x_u, x_v, dissipated, recorded, links, particles, 0, outputs)
     refine = refined = step = 0
@@ -319,9 +329,9 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
         if not event:
             buffers = (work[0], work[1], work[2], work[3], work[4], y_u, y_v)
             increment, varied = _rk4(
-                x_u, x_v, x_acc, slope, dt, buffers, im, k, c, keys, springs, walls, drag, flags
+                x_u, x_v, x_acc, slope, dt, buffers, im, k, c, keys, springs, walls, drag
             )
-            end = _slopes(y_u, y_v, y_acc, im, k, c, keys, springs, walls, drag, flags)
+            end = _slopes(y_u, y_v, y_acc, im, k, c, keys, springs, walls, drag)
             event = varied or end[2] != slope[2]
             if event:
                 refine = EVENT_AFTERMATH + 1
@@ -341,7 +351,6 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
                 springs,
                 walls,
                 drag,
-                flags,
             )
             refine -= 1
             refined += 1
