@@ -1,259 +1,309 @@
-"""Benchmark of the simulation core: numba RK4 against scipy's DOP853 at equal accuracy.
+"""Benchmark of the simulation kernel against its yardsticks, as ratios measured in one run.
 
-Run from the repository root (after ``pip install -e .``)::
+Run from the repository root::
 
-    python benchmarks/bench_integrator.py
+    python benchmarks/bench_integrator.py              # best of 5 interleaved runs
+    python benchmarks/bench_integrator.py --repeat 9
 
-It prints, for the paper's hardest conservative run (N = 26, collision at V0 = 1 m/s,
-2.6 ms simulated):
+It prints, for one elastic collision in the paper's chain (N = 26, +V0 / -V0 at
+V0 = 0.3 m/s, 2 ms simulated, every contact force and the energy recorded every 1 us):
 
-1. the numba fixed-step RK4 with the default step (``chain.simulate(dt=None)``): wall
-   time after compilation and the relative energy drift it achieves;
-2. scipy ``solve_ivp(method="DOP853")`` on a plain-numpy right-hand side of the same
-   equations, at the loosest tolerance that still gives an energy drift <= 1e-9;
-3. a 16-amplitude batch (V0 geometric from 0.02 to 1 m/s, collisions) in one
-   ``simulate`` call after compilation, with steps and ns per particle-step;
-4. diagnostics of where the time goes: the energy drift against the number of steps
-   per contact time (the delta^(3/2) kink makes RK4 converge like dt^2.5 only), and a
-   minimal RK4 kernel for the same chain (no dissipation, walls, sensors or recording)
-   as a floor for the cost of one particle-step.
+1. **kernel / C**: ``chain.physics.integrator.integrate`` (lean kernel) and the general
+   reference kernel against a plain C RK4 (``benchmarks/c/rk4_chain.c``, compiled now
+   with ``cc -O3``; skipped with a message when there is no compiler) at the same step,
+   with and without Kuwabara-Kono dissipation; target lean / C <= 1.3;
+2. **DOP853 / kernel**: scipy ``solve_ivp(method="DOP853")`` on a numba right-hand
+   side, at the loosest tolerance that reaches the kernel's energy drift and its force
+   error against a reference solution; target >= 20;
+3. **batch**: a 16-amplitude sweep in one call on all threads against the same call on
+   one thread (bit-identical results), and per launch against C.
 
-Timings are the best of ``--repeat`` runs (other work on the machine only slows runs
-down). Not a test: it asserts nothing, it reports. The figures measured on the project
-machine are in ``benchmarks/README.md``.
+Timings are the best of ``--repeat`` runs, interleaved so that load on the shared
+machine hits every contender alike; single launches in CPU time (one thread), the
+batch in wall time. Not a test: it asserts nothing, it reports.
 """
 
 from __future__ import annotations
 
 import argparse
+import ctypes
 import math
 import os
 import platform
+import shutil
+import subprocess
+import tempfile
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
 
-import chain
-from chain import (
-    STEEL_100C6,
-    contact_stiffness,
-    default_time_step,
-    simulate,
-    sphere_mass,
-    uniform_chain,
-)
-from chain.physics.simulation import STEPS_PER_CONTACT_TIME
+from chain.physics.integrator import integrate
+from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
+from chain.physics.model import launch_velocities, uniform_chain
+from chain.physics.simulation import default_time_step
 
 N_BEADS = 26
-DURATION = 2.6e-3  # s, the paper's run
-RECORD_INTERVAL = 1e-6  # s, the library's default
-SPEED = 1.0  # m/s, fastest launch of the paper's sweep
-BATCH_SPEEDS = np.geomspace(0.02, 1.0, 16)  # m/s
-TARGET_DRIFT = 1e-9
+DURATION = 2e-3  # s
+SPEED = 0.3  # m/s
+RECORD_INTERVAL = 1e-6  # s
+ETA = 0.58e-6  # s, the paper's Kuwabara-Kono time
 RADIUS = 13e-3  # m
+BATCH_SPEEDS = np.geomspace(0.02, 1.0, 16)  # m/s
+C_SOURCE = Path(__file__).parent / "c" / "rk4_chain.c"
+_DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 
 
-def best_time(function, repeat: int):
-    """(best wall time in s, last result) of ``repeat`` calls of ``function``."""
-    best = math.inf
-    result = None
+def machine() -> str:
+    """CPU model and core count, read from /proc/cpuinfo where there is one."""
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{model}, nproc {os.cpu_count()}, numba threads {numba.get_num_threads()}"
+
+
+def best_times(contenders: dict, repeat: int, clock=time.process_time) -> dict:
+    """Best time (s) of each callable over ``repeat`` interleaved rounds.
+
+    CPU time by default: a single launch runs on one thread, and on a shared machine
+    the CPU time of a one-thread call does not count the time other jobs held the
+    core, which the wall time does."""
+    best = dict.fromkeys(contenders, math.inf)
     for _ in range(repeat):
-        start = time.perf_counter()
-        result = function()
-        best = min(best, time.perf_counter() - start)
-    return best, result
+        for name, function in contenders.items():
+            start = clock()
+            function()
+            best[name] = min(best[name], clock() - start)
+    return best
 
 
-def numpy_chain(n_beads: int):
-    """Right-hand side and energy of Eq. 1 (free ends, equal beads) in plain numpy."""
+def load_c(folder: str):
+    """The C yardstick compiled with the system compiler, or None (with the reason)."""
+    compiler = shutil.which("cc")
+    if compiler is None:
+        return None, "no C compiler (cc) on PATH"
+    library = Path(folder) / "rk4_chain.so"
+    command = [compiler, "-O3", "-shared", "-fPIC", str(C_SOURCE), "-o", str(library), "-lm"]
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        return None, f"cc failed: {done.stderr.strip()}"
+    function = ctypes.CDLL(str(library)).rk4_chain
+    function.restype = ctypes.c_int
+    function.argtypes = [ctypes.c_int] + [ctypes.c_double] * 4 + [ctypes.c_long] * 2
+    function.argtypes += [_DOUBLE_P] * 4
+    return function, " ".join(command)
+
+
+def c_run(function, velocity, eta: float, dt: float, n_steps: int, record_every: int):
+    """One C run of launch ``velocity``; returns (contact forces (S, N-1), energy (S,))."""
     mass = sphere_mass(STEEL_100C6, RADIUS)
     kappa = contact_stiffness(STEEL_100C6, RADIUS, STEEL_100C6, RADIUS)
-
-    def rhs(_t, y):
-        overlap = np.maximum(y[: n_beads - 1] - y[1:n_beads], 0.0)
-        force = kappa * overlap * np.sqrt(overlap)
-        acceleration = np.zeros(n_beads)
-        acceleration[:-1] -= force
-        acceleration[1:] += force
-        return np.concatenate([y[n_beads:], acceleration / mass])
-
-    def energy(y):
-        overlap = np.maximum(y[: n_beads - 1] - y[1:n_beads], 0.0)
-        return 0.5 * mass * np.sum(y[n_beads:] ** 2, axis=0) + 0.4 * kappa * np.sum(
-            overlap**2.5, axis=0
-        )
-
-    return rhs, energy
-
-
-def run_dop853(rtol: float):
-    """One DOP853 run of the benchmark collision; returns (energy drift, n_rhs_calls)."""
-    rhs, energy = numpy_chain(N_BEADS)
-    y0 = np.zeros(2 * N_BEADS)
-    y0[N_BEADS] = SPEED
-    y0[-1] = -SPEED
-    # Absolute tolerances on the scale of the state: overlaps ~ 1e-5 m, speeds ~ V0.
-    atol = np.r_[np.full(N_BEADS, 1e-5 * rtol), np.full(N_BEADS, SPEED * rtol)] * 1e-3
-    samples = np.arange(0.0, DURATION + RECORD_INTERVAL / 2, RECORD_INTERVAL)
-    solution = solve_ivp(
-        rhs, (0.0, DURATION), y0, method="DOP853", rtol=rtol, atol=atol, t_eval=samples
-    )
-    if not solution.success:
-        raise RuntimeError(solution.message)
-    total = energy(solution.y)
-    return float(np.max(np.abs(total - total[0])) / total[0]), solution.nfev
+    n = len(velocity)
+    u, v = np.zeros(n), np.array(velocity, dtype=float)
+    force = np.zeros((n_steps // record_every + 1, n - 1))
+    energy = np.zeros(n_steps // record_every + 1)
+    pointers = [a.ctypes.data_as(_DOUBLE_P) for a in (u, v, force, energy)]
+    function(n, mass, kappa, 1.5 * eta * kappa, dt, n_steps, record_every, *pointers)
+    return force, energy
 
 
 @numba.njit(cache=True)
-def _minimal_derivatives(u, inverse_mass, kappa, acc):
+def _numba_rhs(_t, y, inverse_mass, kappa):
+    # Eq. 1, equal beads, free ends, as a right-hand side for solve_ivp.
+    n = y.shape[0] // 2
+    out = np.empty_like(y)
     previous = 0.0
-    for j in range(u.shape[0] - 1):
-        overlap = u[j] - u[j + 1]
-        force = kappa * overlap * math.sqrt(overlap) if overlap > 0.0 else 0.0
-        acc[j] = (previous - force) * inverse_mass
+    for j in range(n - 1):
+        delta = y[j] - y[j + 1]
+        force = kappa * delta * math.sqrt(delta) if delta > 0.0 else 0.0
+        out[n + j] = (previous - force) * inverse_mass
         previous = force
-    acc[u.shape[0] - 1] = previous * inverse_mass
+    out[2 * n - 1] = previous * inverse_mass
+    out[:n] = y[n:]
+    return out
 
 
-@numba.njit(cache=True)
-def _minimal_rk4(u, v, inverse_mass, kappa, dt, n_steps):
-    # Classical RK4 for N equal beads, free ends, eta = 0, nothing recorded.
-    n = u.shape[0]
-    acc = np.empty(n)
-    u_stage = np.empty(n)
-    v_stage = np.empty(n)
-    u_sum = np.empty(n)
-    v_sum = np.empty(n)
-    for _ in range(n_steps):
-        u_stage[:] = u
-        v_stage[:] = v
-        u_sum[:] = 0.0
-        v_sum[:] = 0.0
-        for stage in range(4):
-            _minimal_derivatives(u_stage, inverse_mass, kappa, acc)
-            weight = 1.0 if stage == 0 or stage == 3 else 2.0
-            h = dt if stage == 2 else 0.5 * dt
-            for p in range(n):
-                u_sum[p] += weight * v_stage[p]
-                v_sum[p] += weight * acc[p]
-                if stage < 3:
-                    u_stage[p] = u[p] + h * v_stage[p]
-                    v_stage[p] = v[p] + h * acc[p]
-        for p in range(n):
-            u[p] += dt / 6.0 * u_sum[p]
-            v[p] += dt / 6.0 * v_sum[p]
+def dop853(rtol: float, velocity, samples):
+    """DOP853 with the numba right-hand side; returns (forces (S, N-1), drift)."""
+    mass = sphere_mass(STEEL_100C6, RADIUS)
+    kappa = contact_stiffness(STEEL_100C6, RADIUS, STEEL_100C6, RADIUS)
+    n = len(velocity)
+    y0 = np.r_[np.zeros(n), velocity]
+    # Absolute tolerances on the scale of the state: overlaps ~ 1e-5 m, speeds ~ V0.
+    atol = np.r_[np.full(n, 1e-5 * rtol), np.full(n, SPEED * rtol)] * 1e-3
+    solution = solve_ivp(
+        _numba_rhs,
+        (0.0, samples[-1]),
+        y0,
+        method="DOP853",
+        rtol=rtol,
+        atol=atol,
+        t_eval=samples,
+        args=(1.0 / mass, kappa),
+    )
+    overlap = np.maximum(solution.y[: n - 1] - solution.y[1:n], 0.0)
+    energy = 0.5 * mass * np.sum(solution.y[n:] ** 2, axis=0)
+    energy += 0.4 * kappa * np.sum(overlap**2.5, axis=0)
+    drift = float(np.max(np.abs(energy - energy[0])) / energy[0])
+    return (kappa * overlap**1.5).T, drift
+
+
+def kernel_against_c(args, c_function) -> dict:
+    """Section 1: lean and reference kernels against C at the default step."""
+    results = {}
+    for eta in (0.0, ETA):
+        model = uniform_chain(N_BEADS, eta=eta)
+        velocity = launch_velocities(model, SPEED, SPEED)
+        dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, SPEED))
+        every = round(RECORD_INTERVAL / dt)
+        n_steps = math.ceil(DURATION / dt - 1e-9)
+
+        def run(kernel, model=model, velocity=velocity, dt=dt, every=every):
+            return integrate(model, velocity, DURATION, dt, every, kernel=kernel)
+
+        contenders = {"lean": lambda: run("lean"), "reference": lambda: run("reference")}
+        if c_function is not None:
+            contenders["C"] = lambda v=velocity[0], e=eta, d=dt, s=n_steps, r=every: c_run(
+                c_function, v, e, d, s, r
+            )
+        for function in contenders.values():
+            function()  # compile
+        best = best_times(contenders, args.repeat)
+        label = "Kuwabara-Kono" if eta else "elastic"
+        ours = run("lean")
+        print(f"\n{label}: dt = {dt:.4e} s, {n_steps} steps, refined {ours.refined_steps[0]}")
+        for name, seconds in best.items():
+            print(f"  {name:10s} {seconds * 1e3:8.2f} ms")
+        if c_function is not None:
+            force, energy = c_run(c_function, velocity[0], eta, dt, n_steps, every)
+            difference = np.abs(ours.link_force[0] - force).max() / force.max()
+            print(
+                f"  force difference lean - C: {difference:.1e}"
+                f" of the peak; energy drift lean {ours.energy_drift[0]:.1e}"
+                + (f", C {np.abs(energy - energy[0]).max() / energy[0]:.1e}" if not eta else "")
+            )
+            results[label] = best["lean"] / best["C"]
+            print(
+                f"  ** lean / C = {results[label]:.2f} (target <= 1.3); "
+                f"reference / C = {best['reference'] / best['C']:.2f}"
+            )
+    return results
+
+
+def against_dop853(args) -> float:
+    """Section 2: DOP853 (numba rhs) at the kernel's drift and force error."""
+    model = uniform_chain(N_BEADS)
+    velocity = launch_velocities(model, SPEED, SPEED)
+    dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, SPEED))
+    every = round(RECORD_INTERVAL / dt)
+    ours = integrate(model, velocity, DURATION, dt, every)
+    # Reference: the same kernel at an eighth of the step (RK4: ~4000x smaller error),
+    # checked against DOP853 at rtol 1e-13.
+    fine = integrate(model, velocity, DURATION, dt / 8, 8 * every).link_force[0]
+    check, check_drift = dop853(1e-13, velocity[0], ours.time)
+    scale = fine.max()
+    print(
+        f"reference: lean kernel at dt / 8; DOP853 at rtol 1e-13 differs from it by "
+        f"{np.abs(check - fine).max() / scale:.1e} of the peak (drift {check_drift:.1e})"
+    )
+    our_error = np.abs(ours.link_force[0] - fine).max() / scale
+    our_drift = ours.energy_drift[0]
+    print(f"lean kernel: energy drift {our_drift:.1e}, force error {our_error:.1e} of the peak")
+    chosen = None
+    for rtol in (1e-9, 3e-10, 1e-10, 3e-11, 1e-11, 3e-12, 1e-12, 3e-13, 1e-13):
+        force, drift = dop853(rtol, velocity[0], ours.time)
+        error = np.abs(force - fine).max() / scale
+        print(f"  DOP853 rtol {rtol:.0e}: drift {drift:.1e}, force error {error:.1e}")
+        if drift <= our_drift and error <= our_error:
+            chosen = rtol
+            break
+    if chosen is None:
+        chosen = 1e-13
+        print(f"  DOP853 never matched both; timed at rtol {chosen:.0e} (a lower bound)")
+    best = best_times(
+        {
+            "lean": lambda: integrate(model, velocity, DURATION, dt, every),
+            "DOP853": lambda: dop853(chosen, velocity[0], ours.time),
+        },
+        args.repeat,
+    )
+    ratio = best["DOP853"] / best["lean"]
+    lean, dop = best["lean"] * 1e3, best["DOP853"] * 1e3
+    print(f"  lean {lean:.2f} ms, DOP853 (rtol {chosen:.0e}) {dop:.1f} ms")
+    print(f"  ** DOP853 / lean = {ratio:.1f} (target >= 20)")
+    return ratio
+
+
+def batch(args, c_function) -> None:
+    """Section 3: the amplitude sweep on all threads, on one thread, and per launch in C."""
+    model = uniform_chain(N_BEADS, eta=ETA)
+    velocity = launch_velocities(model, BATCH_SPEEDS, BATCH_SPEEDS)
+    fastest = float(BATCH_SPEEDS.max())
+    dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, fastest))
+    every = round(RECORD_INTERVAL / dt)
+    n_steps = math.ceil(DURATION / dt - 1e-9)
+    threads = numba.get_num_threads()
+
+    def one_thread():
+        numba.set_num_threads(1)
+        try:
+            return integrate(model, velocity, DURATION, dt, every)
+        finally:
+            numba.set_num_threads(threads)
+
+    contenders = {
+        "all threads": lambda: integrate(model, velocity, DURATION, dt, every),
+        "one thread": one_thread,
+    }
+    if c_function is not None:
+        contenders["C, 16 launches"] = lambda: [
+            c_run(c_function, v, ETA, dt, n_steps, every) for v in velocity
+        ]
+    best = best_times(contenders, args.repeat, clock=time.perf_counter)  # wall: threads
+    wall, cpu = time.perf_counter(), time.process_time()
+    contenders["all threads"]()
+    used = (time.process_time() - cpu) / (time.perf_counter() - wall)
+    same = np.array_equal(contenders["all threads"]().link_force, one_thread().link_force)
+    print(f"\n16 launches, V0 = 0.02..1 m/s, Kuwabara-Kono, dt = {dt:.3e} s, {n_steps} steps")
+    for name, seconds in best.items():
+        print(f"  {name:16s} {seconds * 1e3:8.1f} ms = {seconds / 16 * 1e3:.2f} ms per launch")
+    print(
+        f"  ** one thread / all threads = {best['one thread'] / best['all threads']:.2f}"
+        f" on {threads} threads; results bit-identical: {same}"
+    )
+    print(f"  cores busy during the all-threads call (CPU time / wall time): {used:.2f}")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=3, help="timed runs, best kept")
+    parser.add_argument("--repeat", type=int, default=5, help="interleaved timed rounds")
     args = parser.parse_args()
-
-    print("== machine")
-    print(f"cpu: {platform.processor() or platform.machine()}, {os.cpu_count()} cores")
-    print(f"numba threads: {numba.get_num_threads()}")
+    print(f"machine: {machine()}")
     print(
         f"python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}"
-        f", numba {numba.__version__}, chain {chain.__version__}"
+        f", numba {numba.__version__}"
     )
-
-    model = uniform_chain(N_BEADS)
-
-    def one_collision():
-        return simulate(model, SPEED, SPEED, duration=DURATION, record_interval=RECORD_INTERVAL)
-
-    start = time.perf_counter()
-    one_collision()
-    first_call = time.perf_counter() - start
-    rk4_time, result = best_time(one_collision, args.repeat)
-    steps = math.ceil(DURATION / result.dt - 1e-9)
-    print(f"\n== numba RK4, one collision: N = {N_BEADS}, V0 = {SPEED} m/s, {DURATION * 1e3} ms")
-    print(f"first call (compile or cache load + run): {first_call:.3f} s")
-    print(f"dt = {result.dt:.4e} s (default), steps = {steps}")
-    print(f"energy drift = {result.energy_drift[0]:.2e} (target <= {TARGET_DRIFT:.0e})")
-    print(f"wall time = {rk4_time * 1e3:.1f} ms")
-    print(f"  = {rk4_time / (steps * N_BEADS) * 1e9:.1f} ns per particle-step (one thread)")
-
-    print("\n== scipy solve_ivp DOP853, numpy right-hand side, same run")
-    chosen = None
-    for rtol in (1e-9, 3e-10, 1e-10, 3e-11, 1e-11, 3e-12, 1e-12, 3e-13, 1e-13):
-        drift, calls = run_dop853(rtol)
-        print(f"rtol = {rtol:.0e}: energy drift = {drift:.2e}, rhs calls = {calls}")
-        if drift <= TARGET_DRIFT:
-            chosen = rtol
-            break
-    if chosen is None:
-        raise SystemExit("DOP853 never reached the target drift")
-    dop_time, (drift, calls) = best_time(lambda: run_dop853(chosen), args.repeat)
-    print(f"loosest rtol with drift <= {TARGET_DRIFT:.0e}: {chosen:.0e} (atol scaled alike)")
-    print(f"wall time = {dop_time * 1e3:.1f} ms, energy drift = {drift:.2e}")
-    print(f"\nspeedup numba RK4 / DOP853 = {dop_time / rk4_time:.1f}x (target >= 20x)")
-
-    def batch():
-        return simulate(
-            model, BATCH_SPEEDS, BATCH_SPEEDS, duration=DURATION, record_interval=RECORD_INTERVAL
-        )
-
-    batch()  # compiled already; one untimed call to settle the thread pool
-    batch_time, batch_result = best_time(batch, args.repeat)
-    steps = math.ceil(DURATION / batch_result.dt - 1e-9)
-    particle_steps = steps * N_BEADS * len(BATCH_SPEEDS)
-    threads = numba.get_num_threads()
-    print(f"\n== batch: {len(BATCH_SPEEDS)} collisions, V0 = 0.02..1 m/s (geometric), one call")
-    print(f"dt = {batch_result.dt:.4e} s (set by the fastest launch), steps = {steps}")
-    print(f"max energy drift = {batch_result.energy_drift.max():.2e}")
-    print(f"wall time = {batch_time:.3f} s (target: well under 1 s)")
-    print(
-        f"  = {batch_time / particle_steps * 1e9:.1f} ns wall, "
-        f"{batch_time * threads / particle_steps * 1e9:.1f} ns CPU per particle-step "
-        f"({particle_steps / 1e6:.1f} M particle-steps, {threads} threads)"
-    )
-    # What a per-launch default step would save (each amplitude at its own dt ~ V0^-1/5).
-    own_steps = sum(math.ceil(DURATION / (result.dt * (v / SPEED) ** -0.2)) for v in BATCH_SPEEDS)
-    print(
-        f"  steps if every launch used its own default step: {own_steps} "
-        f"({own_steps / (steps * len(BATCH_SPEEDS)):.2f} of the shared-step total)"
-    )
-
-    print("\n== where the time goes")
-    base = default_time_step(model, SPEED)
-    for factor in (1.0, 1.5, 3.0):
-        run = simulate(
-            model,
-            SPEED,
-            SPEED,
-            duration=DURATION,
-            dt=base * factor,
-            record_interval=RECORD_INTERVAL,
-            max_energy_drift=math.inf,
-        )
-        print(
-            f"{STEPS_PER_CONTACT_TIME / factor:6.0f} steps per contact time: "
-            f"energy drift = {run.energy_drift[0]:.2e}"
-        )
-    mass = sphere_mass(STEEL_100C6, RADIUS)
-    kappa = contact_stiffness(STEEL_100C6, RADIUS, STEEL_100C6, RADIUS)
-    u = np.zeros(N_BEADS)
-    v = np.zeros(N_BEADS)
-    _minimal_rk4(u.copy(), v.copy(), 1.0 / mass, kappa, result.dt, 10)  # compile
-    v[0], v[-1] = SPEED, -SPEED
-    minimal_steps = math.ceil(DURATION / result.dt - 1e-9)
-    minimal_time, _ = best_time(
-        lambda: _minimal_rk4(u.copy(), v.copy(), 1.0 / mass, kappa, result.dt, minimal_steps),
-        args.repeat,
-    )
-    print(
-        f"minimal RK4 kernel, same run: {minimal_time * 1e3:.1f} ms = "
-        f"{minimal_time / (minimal_steps * N_BEADS) * 1e9:.1f} ns per particle-step "
-        f"(library kernel: {rk4_time / (minimal_steps * N_BEADS) * 1e9:.1f} ns)"
-    )
-    print(
-        f"rhs evaluations: RK4 {4 * minimal_steps}, DOP853 {calls} "
-        f"({4 * minimal_steps / calls:.0f}x more for RK4)"
-    )
+    with tempfile.TemporaryDirectory() as folder:
+        c_function, how = load_c(folder)
+        print(f"C yardstick: {how}" if c_function else f"C yardstick skipped: {how}")
+        print("\n== 1. kernel / C, one collision, N = 26, V0 = 0.3 m/s, 2 ms, 1 us records")
+        ratios = kernel_against_c(args, c_function)
+        print("\n== 2. DOP853 (numba right-hand side) / kernel, same accuracy")
+        dop = against_dop853(args)
+        print("\n== 3. batch")
+        batch(args, c_function)
+    print("\n== summary (ratios measured in this run)")
+    for label, ratio in ratios.items():
+        print(f"kernel / C ({label}): {ratio:.2f}  (target <= 1.3)")
+    print(f"DOP853 / kernel: {dop:.1f}  (target >= 20)")
 
 
 if __name__ == "__main__":

@@ -11,281 +11,26 @@ dissipation, which makes the energy drift a check on the step in every run.
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
 from chain.errors import ParameterError, require_positive
+from chain.physics import reference_kernel
+from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_one
 from chain.physics.model import HERTZ, SPRING, ChainModel
-
-#: Status codes written by the kernel.
-_OK = 0
-_NOT_FINITE = 1
 
 #: Default bound on the relative energy drift before a run is declared broken.
 DEFAULT_MAX_ENERGY_DRIFT = 1e-6
 
+#: Fixed seed of the 64-bit keys that fingerprint the set of closed contacts.
+_KEY_SEED = 20141117
+
 
 class IntegrationError(RuntimeError):
     """The integration failed (blow-up or energy drift above threshold)."""
-
-
-#: Contact events (a Hertz contact opening or closing) are integrated in
-#: EVENT_SUBSTEPS substeps, for the step where they happen and the EVENT_AFTERMATH
-#: steps after it: the force kappa delta^(3/2) has an unbounded second derivative at
-#: delta = 0, which costs RK4 its order on exactly those steps.
-EVENT_SUBSTEPS = 16
-EVENT_AFTERMATH = 3
-
-
-@numba.njit(cache=True, inline="always")
-def _hertz_force(stiffness, damping, delta, delta_rate):
-    # Returns (elastic, total); total is clipped at zero because a contact never pulls.
-    if delta <= 0.0:
-        return 0.0, 0.0
-    root = math.sqrt(delta)
-    elastic = stiffness * delta * root
-    if damping == 0.0:
-        return elastic, elastic
-    total = elastic + damping * root * delta_rate
-    if total < 0.0:
-        total = 0.0
-    return elastic, total
-
-
-@numba.njit(cache=True, inline="always")
-def _derivatives(u, v, params, acc, link_force):
-    """Accelerations into ``acc``, link forces into ``link_force``; returns
-    (left wall force, right wall force, dissipated power, closed Hertz contacts)."""
-    (
-        masses,
-        inverse_mass,
-        link_kind,
-        link_stiffness,
-        link_damping,
-        wall_stiffness,
-        wall_damping,
-        drag_rate,
-        has_drag,
-    ) = params
-    n = u.shape[0]
-    power = 0.0
-    left = 0.0
-    right = 0.0
-    if wall_stiffness[0] > 0.0:
-        elastic, left = _hertz_force(wall_stiffness[0], wall_damping[0], -u[0], -v[0])
-        power -= (left - elastic) * v[0]
-    if wall_stiffness[1] > 0.0:
-        elastic, right = _hertz_force(wall_stiffness[1], wall_damping[1], u[n - 1], v[n - 1])
-        power += (right - elastic) * v[n - 1]
-    # One pass: particle j feels the force of the link on its left (previous) and right.
-    closed = (u[0] < 0.0) + (u[n - 1] > 0.0)
-    previous = left
-    for j in range(n - 1):
-        delta = u[j] - u[j + 1]
-        if link_kind[j] == 1:
-            total = link_stiffness[j] * delta
-        elif delta > 0.0:
-            closed += 1
-            rate = v[j] - v[j + 1]
-            elastic, total = _hertz_force(link_stiffness[j], link_damping[j], delta, rate)
-            power += (total - elastic) * rate
-        else:
-            total = 0.0
-        link_force[j] = total
-        acc[j] = (previous - total) * inverse_mass[j]
-        previous = total
-    acc[n - 1] = (previous - right) * inverse_mass[n - 1]
-    if has_drag:
-        for p in range(n):
-            acc[p] -= drag_rate[p] * v[p]
-            power += masses[p] * drag_rate[p] * v[p] * v[p]
-    return left, right, power, closed
-
-
-@numba.njit(cache=True)
-def _potential_energy(u, params):
-    link_kind, link_stiffness, wall_stiffness = params[2], params[3], params[5]
-    n = u.shape[0]
-    energy = 0.0
-    for j in range(n - 1):
-        delta = u[j] - u[j + 1]
-        if link_kind[j] == 1:
-            energy += 0.5 * link_stiffness[j] * delta * delta
-        elif delta > 0.0:
-            energy += 0.4 * link_stiffness[j] * delta * delta * math.sqrt(delta)
-    if wall_stiffness[0] > 0.0 and u[0] < 0.0:
-        delta = -u[0]
-        energy += 0.4 * wall_stiffness[0] * delta * delta * math.sqrt(delta)
-    if wall_stiffness[1] > 0.0 and u[n - 1] > 0.0:
-        delta = u[n - 1]
-        energy += 0.4 * wall_stiffness[1] * delta * delta * math.sqrt(delta)
-    return energy
-
-
-@numba.njit(cache=True)
-def _record(u, v, dissipated, params, acc, link_force, sample, outputs):
-    out_link_force, out_wall_force, out_velocity, out_energy, out_momentum = outputs
-    masses = params[0]
-    left, right, _, _ = _derivatives(u, v, params, acc, link_force)
-    kinetic = 0.0
-    momentum = 0.0
-    for p in range(u.shape[0]):
-        kinetic += 0.5 * masses[p] * v[p] * v[p]
-        momentum += masses[p] * v[p]
-        out_velocity[sample, p] = v[p]
-    for j in range(out_link_force.shape[1]):
-        out_link_force[sample, j] = link_force[j]
-    out_wall_force[sample, 0] = left
-    out_wall_force[sample, 1] = right
-    out_energy[sample, 0] = kinetic
-    out_energy[sample, 1] = _potential_energy(u, params)
-    out_energy[sample, 2] = dissipated
-    out_momentum[sample] = momentum
-
-
-@numba.njit(cache=True, inline="always")
-def _rk4_step(u, v, dt, params, work):
-    """One classical RK4 step of (u, v) in place; returns the dissipated energy and
-    whether the number of closed contacts varied between the stages (a contact event
-    inside the step, even one that closes and reopens within it)."""
-    acc, link_force, u_stage, v_stage, u_sum, v_sum = work
-    n = u.shape[0]
-    for p in range(n):
-        u_stage[p] = u[p]
-        v_stage[p] = v[p]
-        u_sum[p] = 0.0
-        v_sum[p] = 0.0
-    power_sum = 0.0
-    half = 0.5 * dt
-    first_closed = -1
-    varied = False
-    # The weighted slopes are summed as they come, so no stage is stored.
-    for stage in range(4):
-        _, _, power, closed = _derivatives(u_stage, v_stage, params, acc, link_force)
-        if stage == 0:
-            first_closed = closed
-        elif closed != first_closed:
-            varied = True
-        weight = 1.0 if stage == 0 or stage == 3 else 2.0
-        h = dt if stage == 2 else half
-        power_sum += weight * power
-        for p in range(n):
-            u_sum[p] += weight * v_stage[p]
-            v_sum[p] += weight * acc[p]
-            if stage < 3:
-                u_stage[p] = u[p] + h * v_stage[p]
-                v_stage[p] = v[p] + h * acc[p]
-    sixth = dt / 6.0
-    for p in range(n):
-        u[p] += sixth * u_sum[p]
-        v[p] += sixth * v_sum[p]
-    return sixth * power_sum, varied
-
-
-@numba.njit(cache=True)
-def _contact_changed(u_before, u_after, params):
-    """True when a Hertz contact (or wall) opened or closed between two states."""
-    link_kind, wall_stiffness = params[2], params[5]
-    n = u_before.shape[0]
-    for j in range(n - 1):
-        if link_kind[j] != 1:
-            if (u_before[j] - u_before[j + 1] > 0.0) != (u_after[j] - u_after[j + 1] > 0.0):
-                return True
-    if wall_stiffness[0] > 0.0 and (u_before[0] < 0.0) != (u_after[0] < 0.0):
-        return True
-    if wall_stiffness[1] > 0.0 and (u_before[n - 1] > 0.0) != (u_after[n - 1] > 0.0):
-        return True
-    return False
-
-
-@numba.njit(cache=True)
-def _integrate_one(u, v, params, dt, n_steps, record_every, outputs):
-    """RK4 for one launch; ``u`` and ``v`` are updated in place. Returns the status,
-    the step at which it was set, and the number of steps refined at contact events."""
-    n = u.shape[0]
-    work = (
-        np.empty(n),
-        np.empty(max(n - 1, 1)),
-        np.empty(n),
-        np.empty(n),
-        np.empty(n),
-        np.empty(n),
-    )
-    u_start = np.empty(n)
-    v_start = np.empty(n)
-    dissipated = 0.0
-    _record(u, v, dissipated, params, work[0], work[1], 0, outputs)
-    substep = dt / EVENT_SUBSTEPS
-    refine = 0
-    refined = 0
-    for step in range(1, n_steps + 1):
-        for p in range(n):
-            u_start[p] = u[p]
-            v_start[p] = v[p]
-        coarse = refine == 0
-        if coarse:
-            increment, varied = _rk4_step(u, v, dt, params, work)
-            if varied or _contact_changed(u_start, u, params):
-                for p in range(n):
-                    u[p] = u_start[p]
-                    v[p] = v_start[p]
-                coarse = False
-                refine = EVENT_AFTERMATH + 1
-        if not coarse:
-            increment = 0.0
-            event = False
-            for _ in range(EVENT_SUBSTEPS):
-                part, varied = _rk4_step(u, v, substep, params, work)
-                increment += part
-                event = event or varied
-            refine -= 1
-            refined += 1
-            if event or _contact_changed(u_start, u, params):
-                refine = EVENT_AFTERMATH
-        dissipated += increment
-        for p in range(n):
-            if not (math.isfinite(u[p]) and math.isfinite(v[p])):
-                return _NOT_FINITE, step, refined
-        if step % record_every == 0:
-            _record(u, v, dissipated, params, work[0], work[1], step // record_every, outputs)
-    return _OK, n_steps, refined
-
-
-@numba.njit(cache=True, parallel=True)
-def _integrate_batch(
-    u,
-    v,
-    params,
-    dt,
-    n_steps,
-    record_every,
-    out_link_force,
-    out_wall_force,
-    out_velocity,
-    out_energy,
-    out_momentum,
-    out_status,
-    out_fail_step,
-    out_refined,
-):
-    # Launches are independent: one thread each, so results do not depend on the
-    # number of threads.
-    for b in numba.prange(u.shape[0]):
-        outputs = (
-            out_link_force[b],
-            out_wall_force[b],
-            out_velocity[b],
-            out_energy[b],
-            out_momentum[b],
-        )
-        status, step, refined = _integrate_one(
-            u[b], v[b], params, dt, n_steps, record_every, outputs
-        )
-        out_status[b] = status
-        out_fail_step[b] = step
-        out_refined[b] = refined
 
 
 @dataclass(frozen=True)
@@ -295,14 +40,16 @@ class RawTrajectory:
     Attributes
     ----------
     time : (S,) s
-    link_force : (B, S, P-1) N, compression positive
+    link_force : (B, S, K) N, compression positive, of the recorded links ``links``
     wall_force : (B, S, 2) N, left and right wall contact forces
-    velocity : (B, S, P) m/s
+    velocity : (B, S, Q) m/s of the recorded particles ``particles``
     energy : (B, S, 3) J: kinetic, potential (Hertz + springs), dissipated so far
     momentum : (B, S) kg m/s
     final_displacement, final_velocity : (B, P) m, m/s
     dt : s, the step used
     refined_steps : (B,) steps integrated in EVENT_SUBSTEPS substeps (contact events)
+    links : (K,) recorded link indices (all P-1 links by default)
+    particles : (Q,) recorded particle indices (all P particles by default)
     """
 
     time: np.ndarray
@@ -315,6 +62,8 @@ class RawTrajectory:
     final_velocity: np.ndarray
     dt: float
     refined_steps: np.ndarray
+    links: np.ndarray | None = None
+    particles: np.ndarray | None = None
 
     @property
     def total_energy(self) -> np.ndarray:
@@ -338,6 +87,10 @@ def integrate(
     record_every: int = 1,
     initial_displacement: np.ndarray | None = None,
     max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
+    *,
+    links=None,
+    particles=None,
+    kernel: str = "lean",
 ) -> RawTrajectory:
     """Integrate a batch of launches of ``model`` with fixed-step RK4.
 
@@ -358,41 +111,163 @@ def integrate(
     max_energy_drift : float
         Raise :class:`IntegrationError` when the relative drift of
         E_kin + E_pot + E_diss exceeds this; ``math.inf`` disables the check.
+    links : sequence of int, optional
+        Link indices (0..P-2) whose force is recorded; default all. Energies, momentum
+        and wall forces are always recorded.
+    particles : sequence of int, optional
+        Particle indices (0..P-1) whose velocity is recorded; default all.
+    kernel : {"lean", "reference"}
+        "reference" runs the general kernel of :mod:`chain.physics.reference_kernel`
+        (same results bit for bit, slower; for tests and benchmarks).
 
     Returns
     -------
     RawTrajectory
     """
+    duration, dt, record_every = _check_run(duration, dt, record_every, max_energy_drift)
+    velocity, displacement = _initial_state(model, initial_velocity, initial_displacement)
+    links = _index_array("links", links, model.n_particles - 1)
+    particles = _index_array("particles", particles, model.n_particles)
+    if kernel not in ("lean", "reference"):
+        raise ParameterError(f"kernel must be 'lean' or 'reference', got {kernel!r}")
+    n_steps = math.ceil(duration / dt - 1e-9)
+    n_samples = n_steps // record_every + 1
+    run = (displacement, velocity, dt, n_steps, record_every)
+    if kernel == "lean":
+        outputs, report = _run_lean(model, run, n_samples, links, particles)
+    else:
+        outputs, report = _run_reference(model, run, n_samples, links, particles)
+    _raise_on_blow_up(report, dt)
+    trajectory = RawTrajectory(
+        np.arange(n_samples) * (record_every * dt),
+        *outputs,
+        final_displacement=displacement,
+        final_velocity=velocity,
+        dt=dt,
+        refined_steps=report[2],
+        links=links,
+        particles=particles,
+    )
+    _raise_on_drift(trajectory.energy_drift, max_energy_drift, dt)
+    return trajectory
+
+
+def _check_run(duration, dt, record_every, max_energy_drift):
     duration = require_positive("duration", duration)
     dt = require_positive("dt", dt)
     if not isinstance(record_every, int | np.integer) or record_every < 1:
         raise ParameterError(f"record_every must be an integer >= 1, got {record_every!r}")
     if not (max_energy_drift > 0):
         raise ParameterError(f"max_energy_drift must be > 0, got {max_energy_drift!r}")
+    return duration, dt, int(record_every)
+
+
+def _initial_state(model: ChainModel, initial_velocity, initial_displacement):
     n_particles = model.n_particles
     velocity = _batch_array("initial_velocity", initial_velocity, n_particles)
     if initial_displacement is None:
-        displacement = np.zeros_like(velocity)
-    else:
-        displacement = _batch_array("initial_displacement", initial_displacement, n_particles)
-        if displacement.shape != velocity.shape:
-            raise ParameterError(
-                "initial_displacement and initial_velocity must have the same shape, got "
-                f"{displacement.shape} and {velocity.shape}"
-            )
-    n_steps = math.ceil(duration / dt - 1e-9)
-    record_every = int(record_every)
-    n_samples = n_steps // record_every + 1
+        return velocity, np.zeros_like(velocity)
+    displacement = _batch_array("initial_displacement", initial_displacement, n_particles)
+    if displacement.shape != velocity.shape:
+        raise ParameterError(
+            "initial_displacement and initial_velocity must have the same shape, got "
+            f"{displacement.shape} and {velocity.shape}"
+        )
+    return velocity, displacement
+
+
+def _index_array(name: str, values, size: int) -> np.ndarray:
+    """Indices 0..size-1 as an int64 array; ``None`` means all of them."""
+    if values is None:
+        return np.arange(size, dtype=np.int64)
+    array = np.asarray(values)
+    if array.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    if array.ndim != 1 or not np.issubdtype(array.dtype, np.integer):
+        raise ParameterError(f"{name} must be a sequence of integer indices, got {values!r}")
+    if array.min() < 0 or array.max() >= size:
+        raise ParameterError(f"{name} must lie in 0..{size - 1}, got {values!r}")
+    return np.ascontiguousarray(array, dtype=np.int64)
+
+
+def _outputs(batch: int, n_samples: int, n_links: int, n_particles: int):
+    """Zeroed (link force, wall force, velocity, energy, momentum) records."""
+    return (
+        np.zeros((batch, n_samples, n_links)),
+        np.zeros((batch, n_samples, 2)),
+        np.zeros((batch, n_samples, n_particles)),
+        np.zeros((batch, n_samples, 3)),
+        np.zeros((batch, n_samples)),
+    )
+
+
+def _report(batch: int):
+    """(status, failing step, refined steps) per launch."""
+    return tuple(np.zeros(batch, dtype=np.int64) for _ in range(3))
+
+
+def _lean_params(model: ChainModel) -> tuple:
+    """The model as the flat arrays of :mod:`chain.physics.kernels` (see ``_slopes``)."""
+    kind = np.ascontiguousarray(model.link_kind, dtype=np.int64)
+    damping = 1.5 * model.link_eta * model.link_stiffness
+    damping[kind == SPRING] = 0.0
+    n_links = model.n_particles - 1
+    # One key per link and per wall, fixed, so that runs are reproducible.
+    keys = np.random.default_rng(_KEY_SEED).integers(
+        0, np.iinfo(np.uint64).max, size=n_links + 2, dtype=np.uint64, endpoint=True
+    )
+    springs = np.r_[np.flatnonzero(kind == SPRING), n_links].astype(np.int64)
+    walls = np.stack([model.wall_stiffness, 1.5 * model.wall_eta * model.wall_stiffness], axis=1)
+    drag = np.stack([model.drag_rate, model.masses * model.drag_rate], axis=1)
+    # None when absent, so that numba compiles a kernel without them.
+    walls = np.ascontiguousarray(walls) if np.any(model.wall_stiffness > 0) else None
+    drag = np.ascontiguousarray(drag) if np.any(model.drag_rate > 0) else None
+    damped = damping if np.any(damping[kind == HERTZ] > 0) else None
+    return (
+        1.0 / model.masses,
+        np.ascontiguousarray(model.masses, dtype=float),
+        np.ascontiguousarray(model.link_stiffness, dtype=float),
+        damping,
+        keys,
+        springs,
+        walls,
+        drag,
+        kind,
+        damped,
+    )
+
+
+def _run_lean(model: ChainModel, run, n_samples: int, links, particles):
+    displacement, velocity, dt, n_steps, record_every = run
     batch = velocity.shape[0]
-    n_links = max(n_particles - 1, 1)
-    link_force = np.zeros((batch, n_samples, n_links))
-    wall_force = np.zeros((batch, n_samples, 2))
-    recorded_velocity = np.zeros((batch, n_samples, n_particles))
-    energy = np.zeros((batch, n_samples, 3))
-    momentum = np.zeros((batch, n_samples))
-    status = np.zeros(batch, dtype=np.int64)
-    fail_step = np.zeros(batch, dtype=np.int64)
-    refined = np.zeros(batch, dtype=np.int64)
+    outputs = _outputs(batch, n_samples, len(links), len(particles))
+    status, fail_step, refined = report = _report(batch)
+    params = _lean_params(model)
+
+    def launch(b: int) -> None:
+        one = tuple(out[b] for out in outputs)
+        result = _integrate_one(
+            displacement[b], velocity[b], params, dt, n_steps, record_every, links, particles, one
+        )
+        status[b], fail_step[b], refined[b] = result
+
+    # Launches are independent and the kernel releases the GIL: one thread per core,
+    # each launch on one thread, so the results do not depend on the thread count.
+    workers = min(batch, numba.get_num_threads())
+    if workers == 1:
+        for b in range(batch):
+            launch(b)
+    else:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            list(pool.map(launch, range(batch)))
+    return outputs, report
+
+
+def _run_reference(model: ChainModel, run, n_samples: int, links, particles):
+    displacement, velocity, dt, n_steps, record_every = run
+    n_particles = model.n_particles
+    outputs = _outputs(velocity.shape[0], n_samples, max(n_particles - 1, 1), n_particles)
+    report = _report(velocity.shape[0])
     link_damping = 1.5 * model.link_eta * model.link_stiffness
     link_damping[model.link_kind == SPRING] = 0.0
     params = (
@@ -406,42 +281,26 @@ def integrate(
         np.ascontiguousarray(model.drag_rate, dtype=float),
         bool(np.any(model.drag_rate > 0)),
     )
-    _integrate_batch(
-        displacement,
-        velocity,
-        params,
-        dt,
-        n_steps,
-        record_every,
-        link_force,
-        wall_force,
-        recorded_velocity,
-        energy,
-        momentum,
-        status,
-        fail_step,
-        refined,
+    reference_kernel._integrate_batch(
+        displacement, velocity, params, dt, n_steps, record_every, *outputs, *report
     )
+    link_force, wall_force, recorded_velocity, energy, momentum = outputs
+    selected = (link_force[:, :, links], wall_force, recorded_velocity[:, :, particles])
+    return (*selected, energy, momentum), report
+
+
+def _raise_on_blow_up(report, dt: float) -> None:
+    status, fail_step, _ = report
     if np.any(status != _OK):
         b = int(np.flatnonzero(status != _OK)[0])
         raise IntegrationError(
-            f"integration blew up (non-finite state) in launch {b} at step {fail_step[b]} "
+            f"integration blew up (non-finite state) in launch {b} by step {fail_step[b]} "
             f"(t = {fail_step[b] * dt:.3e} s) with dt = {dt:.3e} s: the time step is too "
             "large for this run; reduce dt"
         )
-    trajectory = RawTrajectory(
-        time=np.arange(n_samples) * (record_every * dt),
-        link_force=link_force[:, :, : n_particles - 1],
-        wall_force=wall_force,
-        velocity=recorded_velocity,
-        energy=energy,
-        momentum=momentum,
-        final_displacement=displacement,
-        final_velocity=velocity,
-        dt=dt,
-        refined_steps=refined,
-    )
-    drift = trajectory.energy_drift
+
+
+def _raise_on_drift(drift: np.ndarray, max_energy_drift: float, dt: float) -> None:
     if np.any(drift > max_energy_drift):
         b = int(np.argmax(drift))
         raise IntegrationError(
@@ -449,7 +308,6 @@ def integrate(
             f"{max_energy_drift:.1e} with dt = {dt:.3e} s: the time step is too large for "
             "this run; reduce dt"
         )
-    return trajectory
 
 
 def _batch_array(name: str, values, n_particles: int) -> np.ndarray:
@@ -465,4 +323,13 @@ def _batch_array(name: str, values, n_particles: int) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-__all__ = ["HERTZ", "SPRING", "IntegrationError", "RawTrajectory", "integrate"]
+__all__ = [
+    "DEFAULT_MAX_ENERGY_DRIFT",
+    "EVENT_AFTERMATH",
+    "EVENT_SUBSTEPS",
+    "HERTZ",
+    "SPRING",
+    "IntegrationError",
+    "RawTrajectory",
+    "integrate",
+]

@@ -48,36 +48,40 @@ def default_time_step(model: ChainModel, max_launch_speed: float) -> float:
         Largest launch speed of the run, m/s.
     """
     max_launch_speed = require_positive("max_launch_speed", max_launch_speed)
+    relative = 2 * max_launch_speed
+    moving = _moving_masses(model)
+    hertz = np.flatnonzero(model.link_kind == HERTZ)
+    # Linear in N: the Hertz time is computed once per distinct (m_a, m_b, kappa).
+    triples = np.unique(
+        np.stack([moving[hertz], moving[hertz + 1], model.link_stiffness[hertz]], axis=1), axis=0
+    )
+    steps = [math.inf]
+    for m_a, m_b, kappa in triples:
+        contact = hertz_contact_time(float(m_a), float(m_b), np.float64(kappa), relative)
+        steps.append(contact / STEPS_PER_CONTACT_TIME)
     masses = model.masses
-    shortest = math.inf
-    for j, kind in enumerate(model.link_kind):
+    for j in np.flatnonzero(model.link_kind == SPRING):
         m_a, m_b = masses[j], masses[j + 1]
-        if kind == HERTZ:
-            # Halves of a sensor bead move together: use whole-bead masses around them.
-            m_a, m_b = _moving_mass(model, j), _moving_mass(model, j + 1)
-            contact = hertz_contact_time(m_a, m_b, model.link_stiffness[j], 2 * max_launch_speed)
-            shortest = min(shortest, contact / STEPS_PER_CONTACT_TIME)
-        elif kind == SPRING:
-            reduced = m_a * m_b / (m_a + m_b)
-            period = 2 * math.pi * math.sqrt(reduced / model.link_stiffness[j])
-            shortest = min(shortest, period / STEPS_PER_SPRING_PERIOD)
+        reduced = m_a * m_b / (m_a + m_b)
+        period = 2 * math.pi * math.sqrt(reduced / model.link_stiffness[j])
+        steps.append(period / STEPS_PER_SPRING_PERIOD)
     for side, particle in ((0, 0), (1, model.n_particles - 1)):
         if model.wall_stiffness[side] > 0:
             contact = hertz_contact_time(
-                _moving_mass(model, particle),
-                math.inf,
-                model.wall_stiffness[side],
-                2 * max_launch_speed,
+                float(moving[particle]), math.inf, model.wall_stiffness[side], relative
             )
-            shortest = min(shortest, contact / STEPS_PER_CONTACT_TIME)
-    return shortest
+            steps.append(contact / STEPS_PER_CONTACT_TIME)
+    return min(steps)
 
 
-def _moving_mass(model: ChainModel, particle: int) -> float:
-    for first, last in zip(model.bead_first, model.bead_last):
-        if first <= particle <= last:
-            return float(model.masses[first : last + 1].sum())
-    return float(model.masses[particle])
+def _moving_masses(model: ChainModel) -> np.ndarray:
+    """Per particle, the mass that moves with it, kg: the whole bead for either half of a
+    sensor bead (the halves move together), the particle's own mass otherwise."""
+    moving = np.array(model.masses, dtype=float)
+    for bead in np.flatnonzero(model.bead_last > model.bead_first):
+        first, last = model.bead_first[bead], model.bead_last[bead]
+        moving[first : last + 1] = float(model.masses[first : last + 1].sum())
+    return moving
 
 
 @dataclass(frozen=True)
@@ -89,14 +93,19 @@ class SimulationResult:
     model : ChainModel
     time : (S,) s
     v_left, v_right : (B,) launch speeds, m/s
-    contact_force : (B, S, N-1) N; contact k (joining beads k, k+1) at index k-1
+    contact_force : (B, S, K) N; the recorded contacts (all N-1 by default: contact k,
+        joining beads k and k+1, at index k-1); see :attr:`contacts`
     end_force : (B, S, 2) N; force on bead 1 from its left (wall or striker) and on bead
         N from its right; zero for a free end
-    bead_velocity : (B, S, N) m/s; centre-of-mass velocity of each bead
+    bead_velocity : (B, S, Q) m/s; centre-of-mass velocity of each recorded bead (all N
+        by default); see :attr:`beads`
     sensor_force : (B, S, n_sensors) N; sensor-spring readings k_s * compression
     kinetic_energy, potential_energy, dissipated_energy : (B, S) J
     momentum : (B, S) kg m/s (all particles, strikers included)
     dt : s, the integration step
+    contacts, beads : tuple of int or None
+        Contact and bead numbers recorded when ``simulate`` was asked for a selection;
+        None when all were recorded.
     """
 
     model: ChainModel
@@ -112,6 +121,8 @@ class SimulationResult:
     dissipated_energy: np.ndarray
     momentum: np.ndarray
     dt: float
+    contacts: tuple[int, ...] | None = None
+    beads: tuple[int, ...] | None = None
 
     @property
     def total_energy(self) -> np.ndarray:
@@ -128,7 +139,7 @@ class SimulationResult:
         """Force of contact k (beads k and k+1), (B, S) N."""
         if not isinstance(k, int | np.integer) or not 1 <= k <= self.model.n_beads - 1:
             raise ParameterError(f"contact must be in 1..{self.model.n_beads - 1}, got {k!r}")
-        return self.contact_force[:, :, k - 1]
+        return self.contact_force[:, :, _column(self.contacts, int(k), "contact", "contacts")]
 
     def force_felt(self, bead: int) -> np.ndarray:
         """Force "felt by" bead n, (F_{n-1,n} + F_{n,n+1}) / 2, (B, S) N.
@@ -139,8 +150,8 @@ class SimulationResult:
         """
         index = self.model.bead_index(bead)
         n = self.model.n_beads
-        left = self.end_force[:, :, 0] if index == 0 else self.contact_force[:, :, index - 1]
-        right = self.end_force[:, :, 1] if index == n - 1 else self.contact_force[:, :, index]
+        left = self.end_force[:, :, 0] if index == 0 else self.contact(index)
+        right = self.end_force[:, :, 1] if index == n - 1 else self.contact(index + 1)
         return 0.5 * (left + right)
 
     def sensor(self, bead: int) -> np.ndarray:
@@ -153,7 +164,20 @@ class SimulationResult:
 
     def velocity(self, bead: int) -> np.ndarray:
         """Velocity of bead n, (B, S) m/s."""
-        return self.bead_velocity[:, :, self.model.bead_index(bead)]
+        self.model.bead_index(bead)
+        return self.bead_velocity[:, :, _column(self.beads, int(bead), "bead", "beads")]
+
+
+def _column(recorded, number: int, what: str, keyword: str) -> int:
+    """Column of ``number`` (1-based) in a record of ``recorded`` numbers (None: all)."""
+    if recorded is None:
+        return number - 1
+    if number not in recorded:
+        raise ParameterError(
+            f"{what} {number} was not recorded; pass {keyword}= including it to simulate "
+            f"(recorded: {list(recorded)})"
+        )
+    return recorded.index(number)
 
 
 def simulate(
@@ -165,6 +189,9 @@ def simulate(
     record_interval: float = DEFAULT_RECORD_INTERVAL,
     max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
     initial_displacement=None,
+    *,
+    contacts=None,
+    beads=None,
 ) -> SimulationResult:
     """Launch waves from both ends of ``model`` (a batch of launches) and integrate.
 
@@ -191,6 +218,12 @@ def simulate(
         Particle displacements at t = 0, m (default 0: all particles just touching).
         A positive value on the right striker (or negative on the left one) is an
         initial gap, which delays that launch by gap / speed.
+    contacts : sequence of int, optional
+        Contacts (1..N-1) whose force is recorded; default all. Record only what you
+        read: a long chain's full record is N x samples x 8 bytes per launch. Sensor
+        springs, strikers, walls, energies and momentum are always recorded.
+    beads : sequence of int, optional
+        Beads (1..N) whose velocity is recorded; default all; ``()`` for none.
     """
     velocities = launch_velocities(model, v_left, v_right)
     left = np.atleast_1d(np.asarray(v_left, dtype=float))
@@ -205,6 +238,8 @@ def simulate(
         dt = record_interval / math.ceil(record_interval / default_time_step(model, fastest))
     dt = require_positive("dt", dt)
     record_every = max(1, round(record_interval / dt))
+    contacts = _numbers("contacts", contacts, model.n_beads - 1)
+    beads = _numbers("beads", beads, model.n_beads)
     raw = integrate(
         model,
         velocities,
@@ -213,37 +248,85 @@ def simulate(
         record_every=record_every,
         initial_displacement=initial_displacement,
         max_energy_drift=max_energy_drift,
+        links=_links_to_record(model, contacts),
+        particles=_particles_to_record(model, beads),
     )
-    return _bead_view(model, raw, left.copy(), right.copy())
+    return _bead_view(model, raw, left.copy(), right.copy(), contacts, beads)
 
 
-def _bead_view(model: ChainModel, raw: RawTrajectory, left, right) -> SimulationResult:
-    masses = model.masses
-    velocity = np.stack(
-        [
-            (raw.velocity[:, :, a : b + 1] * masses[a : b + 1]).sum(axis=2)
-            / masses[a : b + 1].sum()
-            for a, b in zip(model.bead_first, model.bead_last)
-        ],
-        axis=2,
+def _numbers(name: str, values, largest: int) -> tuple[int, ...] | None:
+    """Sorted distinct numbers 1..largest, or None for all."""
+    if values is None:
+        return None
+    numbers = sorted({int(x) for x in np.atleast_1d(np.asarray(values, dtype=np.int64))})
+    if numbers and not (1 <= numbers[0] and numbers[-1] <= largest):
+        raise ParameterError(f"{name} must lie in 1..{largest}, got {values!r}")
+    return tuple(numbers)
+
+
+def _links_to_record(model: ChainModel, contacts) -> np.ndarray | None:
+    if contacts is None:
+        return None
+    ends = [j for j in (model.left_striker, model.right_striker - 1) if j >= 0]
+    chosen = [model.contact_link[k - 1] for k in contacts]
+    return np.unique(np.r_[chosen, model.sensor_link, ends].astype(np.int64))
+
+
+def _particles_to_record(model: ChainModel, beads) -> np.ndarray | None:
+    if beads is None:
+        return None
+    chosen = [np.arange(model.bead_first[b - 1], model.bead_last[b - 1] + 1) for b in beads]
+    return np.concatenate([np.zeros(0, dtype=np.int64), *chosen]).astype(np.int64)
+
+
+def _bead_view(
+    model: ChainModel, raw: RawTrajectory, left, right, contacts, beads
+) -> SimulationResult:
+    link_column = np.full(model.n_particles - 1, -1, dtype=np.int64)
+    link_column[raw.links] = np.arange(len(raw.links))
+    contact_links = (
+        model.contact_link
+        if contacts is None
+        else model.contact_link[np.asarray(contacts, dtype=np.int64) - 1]
     )
     end_force = raw.wall_force.copy()
     if model.left_striker >= 0:
-        end_force[:, :, 0] = raw.link_force[:, :, model.left_striker]
+        end_force[:, :, 0] = raw.link_force[:, :, link_column[model.left_striker]]
     if model.right_striker >= 0:
-        end_force[:, :, 1] = raw.link_force[:, :, model.right_striker - 1]
+        end_force[:, :, 1] = raw.link_force[:, :, link_column[model.right_striker - 1]]
     return SimulationResult(
         model=model,
         time=raw.time,
         v_left=left,
         v_right=right,
-        contact_force=raw.link_force[:, :, model.contact_link],
+        contact_force=raw.link_force[:, :, link_column[contact_links]],
         end_force=end_force,
-        bead_velocity=velocity,
-        sensor_force=raw.link_force[:, :, model.sensor_link],
+        bead_velocity=_bead_velocity(model, raw, beads),
+        sensor_force=raw.link_force[:, :, link_column[model.sensor_link]],
         kinetic_energy=raw.energy[:, :, 0],
         potential_energy=raw.energy[:, :, 1],
         dissipated_energy=raw.energy[:, :, 2],
         momentum=raw.momentum,
         dt=raw.dt,
+        contacts=contacts,
+        beads=beads,
     )
+
+
+def _bead_velocity(model: ChainModel, raw: RawTrajectory, beads) -> np.ndarray:
+    """Mass-weighted mean velocity of each recorded bead, (B, S, Q) m/s, computed with
+    the same reductions as a per-bead loop (so the bits do not depend on N)."""
+    numbers = np.arange(model.n_beads) if beads is None else np.asarray(beads, dtype=int) - 1
+    column = np.full(model.n_particles, -1, dtype=np.int64)
+    column[raw.particles] = np.arange(len(raw.particles))
+    masses = model.masses
+    first, last = model.bead_first[numbers], model.bead_last[numbers]
+    velocity = np.empty((*raw.velocity.shape[:2], len(numbers)))
+    single = np.flatnonzero(first == last)
+    weighted = raw.velocity[:, :, column[first[single]]] * masses[first[single]]
+    velocity[:, :, single] = weighted[..., None].sum(axis=3) / masses[first[single]]
+    for i in np.flatnonzero(first != last):
+        a, b = first[i], last[i]
+        part = raw.velocity[:, :, column[a : b + 1]] * masses[a : b + 1]
+        velocity[:, :, i] = part.sum(axis=2) / masses[a : b + 1].sum()
+    return velocity
