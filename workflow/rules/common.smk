@@ -182,6 +182,8 @@ def figure_names():
         names.insert(1, "fig2_experiment_traces")
     if config["figures"]["parity_ssw_vs_N"]:
         names.append("fig_parity_ssw_vs_N")
+    if config["figures"]["sweep_vs_N"]:
+        names.append("fig_c_vs_N")
     return names
 
 
@@ -191,6 +193,7 @@ def final_targets(wildcards=None):
         [f"{TABLES}/{table}.csv" for table in tables]
         + [path for name in figure_names() for path in figure(name)]
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
+        + ([f"{TABLES}/sweep.csv"] if config["figures"]["sweep_vs_N"] else [])
     )
 
 
