@@ -79,7 +79,8 @@ cleanup() {
     [[ ${#PIDS[@]} -gt 0 ]] && say "stopped daemons (pids ${PIDS[*]})"
     [[ $LINKED == 1 ]] && rm -f "$SYSTEM_CONF"
     if [[ $status -ne 0 ]]; then
-        for log in "$WORK"/slurmctld.log "$WORK"/slurmd.log "$WORK"/slurm-run.log; do
+        for log in "$WORK"/munged.out "$WORK"/slurmctld.log "$WORK"/slurmd.log \
+            "$WORK"/slurm-run.log; do
             [[ -f $log ]] && { echo "---- tail of $log"; tail -n 40 "$log"; }
         done
     fi
@@ -115,7 +116,7 @@ SOCKET=$WORK/munge/munge.socket
 setpriv --reuid=munge --regid=munge --init-groups munged --foreground --force \
     --key-file="$WORK/munge/munge.key" --socket="$SOCKET" \
     --pid-file="$WORK/munge/munged.pid" --log-file="$WORK/munge/munged.log" \
-    --seed-file="$WORK/munge/munged.seed" &
+    --seed-file="$WORK/munge/munged.seed" >"$WORK/munged.out" 2>&1 &
 PIDS+=($!)
 wait_for 10 munged munge --socket="$SOCKET" -n
 
@@ -159,10 +160,10 @@ mkdir -p "$(dirname "$SYSTEM_CONF")"
 ln -s "$SLURM_CONF" "$SYSTEM_CONF"
 LINKED=1
 
-slurmctld -D -i -f "$SLURM_CONF" &
+slurmctld -D -i -f "$SLURM_CONF" >"$WORK/slurmctld.out" 2>&1 &
 PIDS+=($!)
 wait_for 20 slurmctld scontrol ping
-slurmd -D -f "$SLURM_CONF" &
+slurmd -D -f "$SLURM_CONF" >"$WORK/slurmd.out" 2>&1 &
 PIDS+=($!)
 node_idle() { sinfo -h -N -o %T | grep -qx idle; }
 wait_for 30 "slurmd (node idle)" node_idle

@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from chain.pipeline.sweep import SWEEP_COLUMNS, sweep_table
 from chain.report.fig_c_vs_N import fig_c_vs_N
@@ -84,3 +90,47 @@ def test_figure_draws_the_table_values():
         float(y) for line in ax.lines if line.get_marker() in ("o", "D") for y in line.get_ydata()
     )
     np.testing.assert_allclose(plotted, sorted(table["C_us_N16"]))
+
+
+# ---- the workflow wiring, by dry runs (no job runs) -------------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def dry_run(*args: str) -> str:
+    """Output of ``snakemake -n`` in the checkout, with the checkout's library."""
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")]),
+    }
+    done = subprocess.run(
+        [sys.executable, "-m", "snakemake", "-n", "--nolock", "--forceall", *args],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout + done.stderr
+
+
+@pytest.mark.workflow
+def test_sweep_overlay_asks_for_its_table_and_both_figures():
+    out = dry_run("--cores", "2", "--configfile", "whatif/sweep.yaml")
+    for job in ("sweep_table", "fig_c_vs_N", "fig_parity_ssw_vs_N"):
+        assert re.search(rf"^{job}\s+1$", out, flags=re.M), job
+    # N = 18..27, three eta: one simulate job per model and chain, even and odd N.
+    assert re.search(r"^simulate\s+30$", out, flags=re.M)
+    assert "results/sweep/tables/sweep.csv" in out
+
+
+@pytest.mark.workflow
+def test_slurm_profile_gives_jobs_their_resources():
+    pytest.importorskip("snakemake_executor_plugin_slurm")
+    out = dry_run("--workflow-profile", "profiles/slurm", "--cores", "8")
+    simulate = out[out.index("rule simulate:") :].split("\n\n")[0]
+    assert "threads: 2" in simulate
+    assert re.search(r"mem_mb=\d+00,.*runtime=\d+.*cpus_per_task=2", simulate), simulate
+    fig1 = out[out.index("rule fig1_setup:") :].split("\n\n")[0]
+    assert re.search(r"mem_mb=1000,.*runtime=15.*cpus_per_task=1", fig1), fig1

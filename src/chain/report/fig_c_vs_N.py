@@ -34,9 +34,9 @@ def fig_c_vs_N(sweep: pd.DataFrame, *, ax=None) -> Figure:
             ax = fig.add_subplot()
         fig = ax.figure
         colors = model_colors(list(dict.fromkeys(sweep["model"])))
-        band = (PAPER["C_exp_us_N16"] - PAPER["C_exp_err_us_N16"], PAPER["C_exp_us_N16"])
-        ax.axhspan(band[0], band[1] + PAPER["C_exp_err_us_N16"], color="0.85", lw=0)
-        ax.axhline(band[1], color="0.5", lw=0.8, label="paper, measured C (N = 25, 26)")
+        c_exp, c_err = PAPER["C_exp_us_N16"], PAPER["C_exp_err_us_N16"]
+        ax.axhspan(c_exp - c_err, c_exp + c_err, color="0.85", lw=0)
+        ax.axhline(c_exp, color="0.5", lw=0.8, label="paper, measured C (N = 25, 26)")
         for model, group in sweep.groupby("model", sort=False):
             group = group.sort_values("N")
             color = colors[model]
