@@ -233,7 +233,8 @@ def simulate_runtime(wildcards, threads):
     return simulate_needs(wildcards, threads).runtime
 
 
-# Virtual experiment: 270 MB peak, 40-170 s per chain (paper run, loaded machine).
+# Virtual experiment: 270 MB peak, 2-3 s per chain (up to 170 s compiling numba kernels
+# on a loaded machine).
 VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
 # pulses, ssw: one trace file at a time, 185 MB peak; ~2 s per trace file.
 ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
