@@ -23,14 +23,14 @@ def start(snakemake) -> logging.Logger:
         force=True,
     )
     logging.captureWarnings(True)
-    _use_job_threads(snakemake.threads)
+    _use_job_threads(getattr(snakemake, "threads", None))
     logger = logging.getLogger(f"rule {snakemake.rule}")
     logger.info("inputs: %s", list(snakemake.input))
     logger.info("outputs: %s", list(snakemake.output))
     return logger
 
 
-def _use_job_threads(threads: int) -> None:
+def _use_job_threads(threads: int | None) -> None:
     """Run numba's parallel loops (the integrator's launches) on the job's cores only.
 
     numba starts one thread per core of the machine, which on a cluster node is far
@@ -38,7 +38,7 @@ def _use_job_threads(threads: int) -> None:
     Scripts that use no numba do not import it here. Results do not depend on the count.
     """
     numba = sys.modules.get("numba")
-    if numba is not None:
+    if numba is not None and threads:
         numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
 
 
