@@ -19,6 +19,9 @@ rule pulses:
     priority: 2
     conda:
         ENV
+    resources:
+        mem_mb=ANALYSIS_JOB["mem_mb"],
+        runtime=ANALYSIS_JOB["runtime"],
     params:
         estimators=config["analysis"]["estimators"],
     script:
@@ -79,6 +82,9 @@ rule ssw:
     priority: 2
     conda:
         ENV
+    resources:
+        mem_mb=ANALYSIS_JOB["mem_mb"],
+        runtime=ANALYSIS_JOB["runtime"],
     params:
         estimator=config["analysis"]["main_estimator"],
     script:

@@ -14,6 +14,9 @@ from chain.pipeline.config import (
 )
 from chain.pipeline.config import experiment_label as experiment_label_of
 from chain.pipeline.deps import script_sources
+from chain.pipeline.resources import simulation_needs
+from chain.physics.materials import get_material
+from chain.physics.model import uniform_chain
 
 check_config(config)
 
@@ -179,6 +182,8 @@ def figure_names():
         names.insert(1, "fig2_experiment_traces")
     if config["figures"]["parity_ssw_vs_N"]:
         names.append("fig_parity_ssw_vs_N")
+    if config["figures"]["sweep_vs_N"]:
+        names.append("fig_c_vs_N")
     return names
 
 
@@ -189,4 +194,48 @@ def final_targets(wildcards=None):
         + [path for name in figure_names() for path in figure(name)]
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
         + [f"{OUT}/article.pdf"]
+        + ([f"{TABLES}/sweep.csv"] if config["figures"]["sweep_vs_N"] else [])
     )
+
+
+# ---- resources (what a batch scheduler is asked for; issue 16) ----------------------
+# mem_mb (MB) and runtime (minutes) per job. A plain local run (`--cores 2`) ignores
+# them; a SLURM run (profiles/slurm) passes them to sbatch. simulate asks for what its
+# chain needs (chain.pipeline.resources: memory ~ N x speeds x duration, measured); the
+# rest is measured on the paper run (peak RSS of the script, results/paper/benchmarks,
+# plus the job's own Snakemake process, 200 MB, times 1.5) and rounded up.
+# Rules not listed take the profile's default-resources.
+def simulate_needs(wildcards, threads):
+    n = int(wildcards.N)
+    sim = config["simulation"]
+    model = uniform_chain(
+        n,
+        get_material(config["material"]),
+        config["radius_m"],
+        MODELS[wildcards.model]["eta_s"],
+        sensor_beads=CHAINS[n]["sensors"] if sim["readout"] == "sensor" else (),
+    )
+    return simulation_needs(
+        model,
+        len(SPEEDS),
+        max(SPEEDS),
+        sim["duration_s"],
+        sim["record_interval_s"],
+        sim["time_step_s"],
+        threads,
+    )
+
+
+def simulate_mem_mb(wildcards, threads):
+    return simulate_needs(wildcards, threads).mem_mb
+
+
+def simulate_runtime(wildcards, threads):
+    return simulate_needs(wildcards, threads).runtime
+
+
+# Virtual experiment: 270 MB peak, 2-3 s per chain (up to 170 s compiling numba kernels
+# on a loaded machine).
+VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
+# pulses, ssw: one trace file at a time, 185 MB peak; ~2 s per trace file.
+ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}

@@ -27,6 +27,10 @@ rule virtual_experiment:
     priority: 3
     conda:
         ENV
+    threads: 2
+    resources:
+        mem_mb=VIRTUAL_EXPERIMENT_JOB["mem_mb"],
+        runtime=VIRTUAL_EXPERIMENT_JOB["runtime"],
     params:
         settings=virtual_settings,
         dataset=VIRTUAL_NAME,

@@ -15,6 +15,10 @@ rule simulate:
     priority: 2
     conda:
         ENV
+    threads: 2
+    resources:
+        mem_mb=simulate_mem_mb,
+        runtime=simulate_runtime,
     params:
         material=config["material"],
         radius_m=config["radius_m"],

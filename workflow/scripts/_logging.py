@@ -26,10 +26,23 @@ def start(snakemake) -> logging.Logger:
     # fontTools reports every font it subsets for a PDF at INFO (a hundred lines of glyph
     # lists per figure): not about the run, and formatting them costs time.
     logging.getLogger("fontTools").setLevel(logging.WARNING)
+    _use_job_threads(getattr(snakemake, "threads", None))
     logger = logging.getLogger(f"rule {snakemake.rule}")
     logger.info("inputs: %s", list(snakemake.input))
     logger.info("outputs: %s", list(snakemake.output))
     return logger
+
+
+def _use_job_threads(threads: int | None) -> None:
+    """Run numba's parallel loops (the integrator's launches) on the job's cores only.
+
+    numba starts one thread per core of the machine, which on a cluster node is far
+    more than the job's allocation (the rule's ``threads:``, sbatch --cpus-per-task).
+    Scripts that use no numba do not import it here. Results do not depend on the count.
+    """
+    numba = sys.modules.get("numba")
+    if numba is not None and threads:
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
 
 
 def _terminate(signum, frame):

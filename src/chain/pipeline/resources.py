@@ -1,0 +1,117 @@
+"""What a simulation job asks a batch scheduler for: memory (MB) and run time (minutes).
+
+A SLURM job is killed when it passes its memory or time request, and waits longer in
+the queue the more it asks, so the simulate rule asks for what its chain needs
+(``workflow/rules/common.smk`` calls :func:`simulation_needs` per job).
+
+How the memory was estimated
+----------------------------
+The integrator keeps every recorded sample of every particle of a batch of B launches:
+forces and velocities, (B, S, P) arrays with S = duration / record_interval samples,
+copied once more into the per-bead view, then read out into a trace table. The peak
+resident memory of the simulate script, measured (``resource.getrusage``, numba
+threads 2) for N = 16..100 beads, 4..24 launch speeds and 1.5..5.2 ms, is
+
+    peak ~ 200 MB + (48 N + 80) bytes x B x S
+
+within 10 MB (200 MB: Python, numpy, pandas, numba and the cached kernels; 48 bytes =
+six float64 per particle and sample). The paper's N = 26, 12 speeds, 2.6 ms peaks at
+240 MB; N = 100, 24 speeds, 5.2 ms at 790 MB. A cluster job also holds the Snakemake
+process that runs the script (:data:`SNAKEMAKE_MB`, measured 200 MB), and the request
+is :data:`SAFETY` times the sum, rounded up to 100 MB.
+
+How the run time was estimated
+------------------------------
+RK4 costs about the same per particle and step whatever the chain: at most
+:data:`SECONDS_PER_PARTICLE_STEP` on one core of this project's (shared, loaded) test
+machine. A job runs 2 B launches (collision and reference shots) of duration / dt steps
+each; dt is :func:`chain.physics.simulation.default_time_step` at the fastest launch
+unless the config sets it. The request is :data:`SAFETY` times that plus start-up, and
+never under :data:`MIN_RUNTIME_MIN` (queues round short jobs up anyway). Every paper
+job asks for the minimum; the estimate matters for long sweeps (N = 100, 5 ms,
+24 speeds: ~40 s of work).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from chain.errors import require_int, require_positive
+from chain.physics.model import ChainModel
+from chain.physics.simulation import default_time_step
+
+#: Resident memory of the simulate script before it allocates traces, MB (measured).
+BASE_MB = 200.0
+#: Bytes held per launch, recorded sample and bead (six float64, measured 47-48).
+BYTES_PER_BEAD_SAMPLE = 48.0
+#: Bytes held per launch and recorded sample besides the beads (trace table rows).
+BYTES_PER_SAMPLE = 80.0
+#: Resident memory of the Snakemake process that runs the script inside the job, MB.
+SNAKEMAKE_MB = 200.0
+#: Factor between the estimate and the request (memory and time).
+SAFETY = 1.5
+#: RK4 cost per particle and time step on one core, s (measured 2e-8 to 6e-8, loaded).
+SECONDS_PER_PARTICLE_STEP = 1e-7
+#: Python start-up, imports and file writing of one job, s.
+STARTUP_S = 60.0
+#: Shortest run time asked for, minutes.
+MIN_RUNTIME_MIN = 10
+
+
+@dataclass(frozen=True)
+class JobNeeds:
+    """A job's request: ``mem_mb`` (MB) and ``runtime`` (minutes), Snakemake's names."""
+
+    mem_mb: int
+    runtime: int
+
+
+def simulation_needs(
+    model: ChainModel,
+    n_launches: int,
+    max_launch_speed: float,
+    duration: float,
+    record_interval: float,
+    dt: float | None = None,
+    threads: int = 1,
+) -> JobNeeds:
+    """Memory and run time to ask for a simulate job (collision and reference batches).
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain simulated.
+    n_launches : int
+        Launch speeds B; each gives a collision and a reference shot.
+    max_launch_speed : float
+        Fastest launch speed, m/s (sets the default time step).
+    duration : float
+        Simulated time, s.
+    record_interval : float
+        Time between recorded samples, s.
+    dt : float, optional
+        RK4 step, s; default :func:`chain.physics.simulation.default_time_step`.
+    threads : int
+        Cores the job gets (launches run in parallel threads).
+
+    Returns
+    -------
+    JobNeeds
+        ``mem_mb`` in MB (multiple of 100), ``runtime`` in minutes.
+    """
+    n_launches = require_int("n_launches", n_launches, 1)
+    threads = require_int("threads", threads, 1)
+    duration = require_positive("duration", duration)
+    record_interval = require_positive("record_interval", record_interval)
+    if dt is None:
+        dt = default_time_step(model, require_positive("max_launch_speed", max_launch_speed))
+    samples = duration / record_interval + 1
+    held = (BYTES_PER_BEAD_SAMPLE * model.n_particles + BYTES_PER_SAMPLE) * n_launches * samples
+    memory = SAFETY * (BASE_MB + SNAKEMAKE_MB + held / 1e6)
+    work = 2 * n_launches * model.n_particles * (duration / dt) * SECONDS_PER_PARTICLE_STEP
+    seconds = SAFETY * (STARTUP_S + work / min(threads, n_launches))
+    return JobNeeds(
+        mem_mb=int(100 * math.ceil(memory / 100)),
+        runtime=max(MIN_RUNTIME_MIN, math.ceil(seconds / 60)),
+    )

@@ -1,0 +1,18 @@
+"""Sweep table: C and SSW slope per model and chain, with each model's eta
+(chain.pipeline.sweep.sweep_table)."""
+
+import pandas as pd
+from _logging import start
+
+from chain.atomic import write_csv_atomic
+from chain.pipeline.sweep import sweep_table
+
+log = start(snakemake)
+table = sweep_table(
+    pd.read_csv(snakemake.input.delay_fits),
+    pd.read_csv(snakemake.input.ssw_fits),
+    snakemake.params.eta_s,
+    snakemake.params.estimator,
+)
+log.info("%d rows (models x chains)", len(table))
+write_csv_atomic(table, snakemake.output[0])
