@@ -15,7 +15,7 @@ import pytest
 import chain
 from chain.analysis.delays import delay_fit_table, delay_table
 from chain.analysis.pulses import pulse_table
-from chain.analysis.ssw import ssw_fit_table, ssw_table
+from chain.analysis.ssw import NOT_RESOLVED, ssw_fit_table, ssw_table
 from chain.physics.theory import ballistic_delay_constant_exact
 
 #: Launch speeds: F_m from ~9 N to ~1 kN at the first sensor.
@@ -31,8 +31,6 @@ EXPONENT_TOLERANCE = 5e-4
 #: the ballistic picture is an approximation (measured C / C_bal_exact = 1.10 for
 #: N = 25 and 1.02 for N = 26).
 C_RATIO_RANGE = (0.9, 1.2)
-#: SSW / F_m is the same at every amplitude (self-similarity), to sampling accuracy.
-SSW_RATIO_SPREAD = 0.01
 
 
 @pytest.fixture(scope="module")
@@ -76,13 +74,12 @@ def test_delay_exponent_is_minus_one_sixth(analysed, n_beads):
     assert C_RATIO_RANGE[0] < ratio < C_RATIO_RANGE[1], row["C_us_N16"]
 
 
-def test_ssw_stronger_when_waves_cross_at_a_contact(analysed):
+def test_ssw_not_resolved_at_the_paper_sensors(analysed):
+    # Four beads from the collision point the SSW is still a shoulder on the crossed
+    # pulse: it separates from contact 17 of the 26-bead chain on and nowhere in the
+    # 25-bead one (tests/test_ssw_track.py). So no sensor value, at any amplitude (the
+    # chain is self-similar), and no fit.
     ssw = analysed[2]
-    residual = ssw[ssw["method"] == "residual"]
-    assert residual["ok"].all()
-    for _, group in residual.groupby("N"):
-        ratio = group["ssw_N"] / group["F_m_N"]
-        assert ratio.std() / ratio.mean() < SSW_RATIO_SPREAD
-    slopes = ssw_fit_table(ssw).set_index("N")["slope"]
-    # Even chain: the waves meet at the middle contact, and the SSW is larger (Sec. V).
-    assert slopes[26] > slopes[25] > 0
+    assert not ssw["ok"].any()
+    assert (ssw["reason"] == NOT_RESOLVED).all()
+    assert (ssw_fit_table(ssw)["n_points"] == 0).all()

@@ -110,3 +110,56 @@ rule ssw_fits:
         ENV
     script:
         "../scripts/ssw_fits.py"
+
+
+# The SSW as a wave (issue 13): each chain's collisions re-simulated with every contact
+# recorded (the simulate rule keeps two sensor readings only), the SSW tracked contact
+# by contact; the field of the shot the space-time figure shows is kept.
+rule ssw_track:
+    input:
+        code("ssw_track"),
+    output:
+        track=f"{OUT}/simulation/{{model}}_N{{N}}_ssw_track.csv",
+        field=f"{OUT}/simulation/{{model}}_N{{N}}_field.csv",
+    log:
+        f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
+    benchmark:
+        f"{BENCH}/simulate/{{model}}_N{{N}}_ssw_track.tsv"
+    priority: 2
+    conda:
+        ENV
+    params:
+        material=config["material"],
+        radius_m=config["radius_m"],
+        eta_s=lambda wildcards: MODELS[wildcards.model]["eta_s"],
+        sensors=lambda wildcards: CHAINS[int(wildcards.N)]["sensors"],
+        speeds_m_s=SPEEDS,
+        simulation=config["simulation"],
+        representative_force_N=config["figures"]["representative_force_N"],
+        representative_index=config["figures"]["representative_index"],
+    script:
+        "../scripts/ssw_track.py"
+
+
+rule ssw_speed:
+    input:
+        tracks=[
+            f"{OUT}/simulation/{model}_N{n}_ssw_track.csv"
+            for _, model, n in SIMULATION_PARTS
+        ],
+        lib=code("ssw_speed"),
+    output:
+        track=f"{TABLES}/ssw_track.csv",
+        speed=f"{TABLES}/ssw_speed.csv",
+    log:
+        f"{LOGS}/tables/ssw_speed.log",
+    benchmark:
+        f"{BENCH}/tables/ssw_speed.tsv"
+    priority: 1
+    conda:
+        ENV
+    params:
+        material=config["material"],
+        radius_m=config["radius_m"],
+    script:
+        "../scripts/ssw_speed.py"

@@ -188,7 +188,7 @@ def figure_names():
 
 
 def final_targets(wildcards=None):
-    tables = ["pulses", "delays", "delay_fits", "ssw", "ssw_fits"]
+    tables = ["pulses", "delays", "delay_fits", "ssw", "ssw_fits", "ssw_track", "ssw_speed"]
     return (
         [f"{TABLES}/{table}.csv" for table in tables]
         + [path for name in figure_names() for path in figure(name)]

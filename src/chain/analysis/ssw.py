@@ -1,27 +1,35 @@
-"""Secondary solitary waves (SSW): the small waves born where the two pulses crossed.
+"""Secondary solitary waves (SSW) at the sensors: the small waves born where the two
+pulses crossed, read behind each crossed pulse.
 
-After the crossing each wave is followed by a secondary wave. At the paper's sensor
-positions it has not yet separated from the crossed pulse: in simulations it is a
-shoulder on the trailing edge. Two measurements, one row each in ``ssw.csv``:
+At the paper's sensors the SSW has barely, or not yet, separated from the crossed pulse
+(``chain.analysis.ssw_track`` follows it contact by contact). A value is therefore
+reported only where the SSW is **resolved at the sensor**:
 
-``residual`` (default)
-    The reference pulse read at the same distance from the launching end (the
-    reference shot of the same amplitude at S2: for LSTW crossed at S2 that is the same
-    sensor; for RSTW crossed at S1 the symmetric sensor placement makes S2 the same
-    distance from its launching end) is turned into a solitary wave of the crossed
-    pulse's size by the Hertz self-similarity -- force scale a, time scale a^(-1/6) --
-    and aligned on the crossed pulse by least squares on its rising edge and top
-    (from T - tau to its highest sample, which the trailing SSW does not reach), a and
-    the time shift free. The SSW amplitude is the largest value of crossed signal minus this
-    template from the crossed pulse's peak to :data:`WINDOW_TAUS` tau after it,
-    after a quadratic Savitzky-Golay smoothing tau/2 long (the SSW is about tau wide,
-    the noise is not). With no SSW it is ~0 (a few noise sigma / sqrt(tau/2 samples)).
-``peak``
-    A distinct local maximum of the (smoothed) crossed signal in the same window, its
-    height above the baseline; flagged ``ok`` False where there is none (the shoulder
-    case).
+1. **Template.** The reference pulse at the same distance from the launching end (the
+   reference shot of the same amplitude at S2: for LSTW crossed at S2 that is the same
+   sensor; for RSTW crossed at S1 the symmetric sensor placement makes S2 the same
+   distance from its launching end) is turned into a solitary wave of the crossed
+   pulse's size by the Hertz self-similarity -- force scale a, time scale a^(-1/6) --
+   and aligned on the crossed pulse by least squares on its rising edge and top (from
+   T - tau to its highest sample, which the trailing SSW does not reach), a and the
+   time shift free. ``template_misfit_N`` is the largest misfit there (of the
+   smoothed residual, as the SSW is read from it).
+2. **A distinct bump.** Within :data:`WINDOW_TAUS` tau behind the crossed peak, the
+   (smoothed) signal must have a local maximum of prominence at least
+   :data:`MIN_PEAK_FRACTION` of the crossed pulse and :data:`MIN_PEAK_SNR` sigma of the
+   smoothed noise. The lowest point between the crossed peak and that maximum is the
+   crossed pulse's **trailing minimum**; nothing before it is ever read as SSW.
+3. **Its size.** ``residual``: the largest value of (signal - template), smoothed, from
+   the trailing minimum to the bump's far base. ``peak``: the bump's height above the
+   baseline. The smoothing is quadratic Savitzky-Golay, tau/2 long (the SSW is about
+   tau wide, the noise is not).
+4. **Above the floor.** The residual must exceed ``ssw_floor_N`` =
+   :data:`RESOLVE_FACTOR` x (template misfit + :data:`NOISE_SIGMAS` sigma of the
+   smoothed noise): residuals of the size of the misfit where no SSW can be are shape
+   mismatch, not SSW.
 
-:func:`ssw_fit_table` fits SSW = slope x F_m through the origin (Fig. 5).
+Otherwise both rows have ``ok`` False with the reason :data:`NOT_RESOLVED`.
+:func:`ssw_fit_table` fits SSW = slope x F_m through the origin on resolved rows (Fig. 5).
 """
 
 from __future__ import annotations
@@ -42,6 +50,15 @@ from chain.traces import iter_shots, sensor_beads
 
 #: The SSW is looked for from the crossed pulse's peak to this many tau after it.
 WINDOW_TAUS = 6.0
+
+#: A resolved SSW exceeds this many times (template misfit + noise), its floor.
+RESOLVE_FACTOR = 2.0
+
+#: The noise part of the floor, in standard deviations of the smoothed noise.
+NOISE_SIGMAS = 3.0
+
+#: Reason of the rows where no SSW clears the floor.
+NOT_RESOLVED = "not resolved at the sensor"
 
 #: Least prominence of a distinct SSW peak, as a fraction of the crossed pulse.
 MIN_PEAK_FRACTION = 0.005
@@ -72,6 +89,8 @@ SSW_COLUMNS = (
     "reference_shot",
     "template_scale",
     "template_misfit_N",
+    "ssw_floor_N",
+    "trailing_min_us",
 )
 
 #: Columns of :func:`ssw_fit_table`.
@@ -125,7 +144,7 @@ def measure_ssw(
     reference_baseline_N: float = 0.0,
     noise_N: float = 0.0,
 ) -> dict:
-    """SSW behind one crossed pulse, by both methods.
+    """SSW behind one crossed pulse, by both methods, where it is resolved.
 
     Parameters
     ----------
@@ -145,68 +164,100 @@ def measure_ssw(
     Returns
     -------
     dict
-        ``{"residual": (ssw_N, time_s, reason), "peak": (...), "scale": a,
-        "misfit": N}``; ``reason`` is "" when the value is valid (NaN values otherwise);
-        ``misfit`` is the largest |template - signal| on the rising edge used for the
-        alignment.
+        ``{"residual": (ssw_N, time_s, reason), "peak": (...), "scale": a, "misfit": N,
+        "floor": N, "trailing_min_s": s}``; ``reason`` is "" when the SSW is resolved
+        (values NaN otherwise); ``misfit`` is the largest smoothed |signal - template| on the
+        rising edge, ``floor`` the least resolved residual, ``trailing_min_s`` the time of
+        the crossed pulse's trailing minimum (NaN without a distinct bump).
     """
     time = np.asarray(time_s, dtype=float)
     signal = np.asarray(force_N, dtype=float) - baseline_N
-    ref_time = np.asarray(reference_time_s, dtype=float)
     ref_signal = np.asarray(reference_force_N, dtype=float) - reference_baseline_N
-    dt = float(np.median(np.diff(time)))
-    tau, arrival = crossed_tau_s, crossed_arrival_s
-    # Rising edge and top of the crossed pulse: untouched by what trails it.
+    nan = (math.nan, math.nan, "crossed pulse not sampled")
+    result = {"residual": nan, "peak": nan, "scale": math.nan, "misfit": math.nan}
+    result.update(floor=math.nan, trailing_min_s=math.nan)
+    spline = CubicSpline(np.asarray(reference_time_s, dtype=float), ref_signal, extrapolate=False)
+    aligned = _align_template(
+        time,
+        signal,
+        crossed_arrival_s,
+        crossed_tau_s,
+        crossed_peak_N / reference_peak_N,
+        spline,
+        reference_arrival_s,
+    )
+    if aligned is None:
+        return result
+    scale, shift, edge, top = aligned
+    template = _template(spline, time, scale, shift, reference_arrival_s)
+    smooth, noise_gain = _smoother(time, crossed_tau_s)
+    residual = smooth(signal - template)
+    # Measured on the smoothed residual, as the SSW is: the noise enters once, below.
+    misfit = float(np.max(np.abs(residual[edge])))
+    floor = RESOLVE_FACTOR * (misfit + NOISE_SIGMAS * noise_gain * noise_N)
+    result.update(scale=scale, misfit=misfit, floor=floor)
+    window = np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)
+    prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
+    bump = _distinct_bump(smooth(signal), top, int(window[-1]), prominence)
+    unresolved = (math.nan, math.nan, NOT_RESOLVED)
+    result.update(residual=unresolved, peak=unresolved)
+    if bump is None:
+        return result
+    low, peak, far = bump
+    best = low + int(np.argmax(residual[low : far + 1]))
+    result["trailing_min_s"] = float(time[low])
+    if residual[best] > floor:
+        result["residual"] = (float(residual[best]), float(time[best]), "")
+        result["peak"] = (float(smooth(signal)[peak]), float(time[peak]), "")
+    return result
+
+
+def _align_template(time, signal, arrival, tau, scale_guess, spline, ref_arrival):
+    """Fit the template's scale a and arrival on the crossed pulse's rising edge and top.
+
+    Returns (a, arrival s, the rising edge as a slice, index of the top sample), or None
+    when the pulse has fewer than 6 samples within tau of its arrival.
+    """
     near = np.flatnonzero(np.abs(time - arrival) < tau)
     if near.size < 6:
-        nan = (math.nan, math.nan, "crossed pulse not sampled")
-        return {"residual": nan, "peak": nan, "scale": math.nan, "misfit": math.nan}
+        return None
     top = int(near[np.argmax(signal[near])])
     edge = slice(int(near[0]), top + 1)
-    spline = CubicSpline(ref_time, ref_signal, extrapolate=False)
 
     def misfit(params):
-        scale, shift = params
-        return _template(spline, time[edge], scale, shift, reference_arrival_s) - signal[edge]
+        return _template(spline, time[edge], params[0], params[1], ref_arrival) - signal[edge]
 
-    start = (crossed_peak_N / reference_peak_N, arrival)
     solution = least_squares(
-        misfit, start, x_scale=(0.01, 0.01 * tau), bounds=([0, -np.inf], np.inf)
+        misfit, (scale_guess, arrival), x_scale=(0.01, 0.01 * tau), bounds=([0, -np.inf], np.inf)
     )
     scale, shift = solution.x
-    # How well a solitary wave matches the crossed pulse where no SSW can be: a floor
-    # below which an SSW amplitude means nothing.
-    edge_misfit = float(np.max(np.abs(solution.fun)))
-    template = _template(spline, time, scale, shift, reference_arrival_s)
-    window = (time >= time[top]) & (time <= time[top] + WINDOW_TAUS * tau)
+    return float(scale), float(shift), edge, top
+
+
+def _smoother(time, tau):
+    """Quadratic Savitzky-Golay smoothing tau/2 long, and its gain on white noise."""
+    dt = float(np.median(np.diff(time)))
     length = round(0.5 * tau / dt) | 1
-    smoothing = 5 <= length < len(time)
+    if not 5 <= length < len(time):
+        return (lambda values: values), 1.0
+    gain = math.sqrt(float(np.sum(savgol_coeffs(length, 2) ** 2)))
+    return (lambda values: savgol_filter(values, length, 2)), gain
 
-    def smooth(values):
-        return savgol_filter(values, length, 2) if smoothing else values
 
-    noise_gain = math.sqrt(float(np.sum(savgol_coeffs(length, 2) ** 2))) if smoothing else 1.0
-    residual = smooth(signal - template)
-    indices = np.flatnonzero(window)
-    best = int(indices[np.argmax(residual[indices])])
-    result = {
-        "residual": (float(residual[best]), float(time[best]), ""),
-        "scale": float(scale),
-        "misfit": edge_misfit,
-    }
-    # Distinct peaks: local maxima of the smoothed signal from the main pulse's rise to
-    # the end of the window, the main pulse's own maximum (the largest) excluded.
-    region = np.arange(int(near[0]), int(indices[-1]) + 1)
-    smoothed = smooth(signal)[region]
-    prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
-    peaks, _ = find_peaks(smoothed, prominence=prominence)
-    peaks = peaks[peaks > np.argmax(smoothed)]
-    if peaks.size:
-        first = int(peaks[0])
-        result["peak"] = (float(smoothed[first]), float(time[region[first]]), "")
-    else:
-        result["peak"] = (math.nan, math.nan, "no distinct SSW peak")
-    return result
+def _distinct_bump(smoothed, top: int, last: int, prominence: float):
+    """The first local maximum after the crossed peak ``top`` (up to index ``last``)
+    with at least ``prominence``: (trailing minimum, maximum, far base) indices, or None.
+
+    Prominence is measured within [top, last], so the crossed pulse itself bounds the
+    bump on the near side and the trailing minimum is the lowest point between them.
+    """
+    region = smoothed[top : last + 1]
+    peaks, properties = find_peaks(region, prominence=prominence)
+    if not peaks.size:
+        return None
+    peak = int(peaks[0])
+    low = int(np.argmin(region[: peak + 1]))
+    return top + low, top + peak, top + int(properties["right_bases"][0])
 
 
 def ssw_table(
@@ -239,94 +290,120 @@ def ssw_table(
         wave (at the first sensor it met), ``ssw_time_us`` the time of the SSW maximum
         (same origin as ``t_s``), ``ssw_lag_us`` its delay after the crossed pulse's T,
         ``template_scale`` the force ratio a of the template to the reference,
-        ``template_misfit_N`` the largest |template - signal| on the rising edge (the
-        floor of the residual method).
+        ``template_misfit_N`` the largest smoothed |signal - template| on the rising edge,
+        ``ssw_floor_N`` the least resolved value, ``trailing_min_us`` the time of the
+        crossed pulse's trailing minimum. Unresolved rows: ``ok`` False, reason
+        :data:`NOT_RESOLVED`, ``ssw_N`` NaN.
     """
     pulses = apply_selection(pulses[pulses["estimator"] == estimator], selection)
     beads = sensor_beads(traces)
-    bead_of = {"S1": beads[0], "S2": beads[-1]}
-    signals = {shot: (meta, time, forces) for shot, meta, time, forces in iter_shots(traces)}
-    keys = ["source", "model", "N"]
-    rows = []
-    lookup = {
-        (row.source, row.model, row.N, row.shot, row.sensor, row.role): row
-        for row in pulses.itertuples(index=False)
+    context = {
+        "bead_of": {"S1": beads[0], "S2": beads[-1]},
+        "signals": {shot: (meta, t, forces) for shot, meta, t, forces in iter_shots(traces)},
+        "lookup": {
+            (row.source, row.model, row.N, row.shot, row.sensor, row.role): row
+            for row in pulses.itertuples(index=False)
+        },
+        "references": _usable_references(pulses),
     }
-    references = pulses[(pulses["role"] == "reference") & (pulses["sensor"] == "S2")]
-    references = references[is_ok(references)]
-    collisions = pulses[pulses["kind"] == "collision"][[*keys, "shot", "amplitude"]]
-    for shot in collisions.drop_duplicates().itertuples(index=False):
-        if shot.shot not in signals:
+    keys = ["source", "model", "N", "shot", "amplitude"]
+    collisions = pulses[pulses["kind"] == "collision"][keys].drop_duplicates()
+    rows = []
+    for shot in collisions.itertuples(index=False):
+        signal = context["signals"].get(shot.shot)
+        if signal is None or (signal[0]["source"], signal[0]["model"], signal[0]["N"]) != (
+            shot.source,
+            shot.model,
+            shot.N,
+        ):
             continue
-        meta, time, forces = signals[shot.shot]
-        if (meta["source"], meta["model"], meta["N"]) != (shot.source, shot.model, shot.N):
-            continue
-        for sensor, (wave, first) in _CROSSED.items():
-            where = (shot.source, shot.model, shot.N, shot.shot)
-            crossed = lookup.get((*where, sensor, "crossed"))
-            incident = lookup.get((*where, first, "incident"))
-            base = {
-                "source": shot.source,
-                "model": shot.model,
-                "N": shot.N,
-                "shot": shot.shot,
-                "amplitude": shot.amplitude,
-                "sensor": sensor,
-                "bead": bead_of[sensor],
-                "wave": wave,
-            }
-            same = references[
-                (references["source"] == shot.source)
-                & (references["model"] == shot.model)
-                & (references["N"] == shot.N)
-                & (references["amplitude"] == shot.amplitude)
-            ]
-            reason = ""
-            if crossed is None or not bool(crossed.ok):
-                reason = "crossed pulse not measured"
-            elif incident is None or not bool(incident.ok):
-                reason = "incident pulse not measured"
-            elif same.empty:
-                reason = "no usable reference shot of this amplitude"
-            if reason:
-                for method in SSW_METHODS:
-                    rows.append(_row(base, method, math.nan, math.nan, math.nan, reason))
-                continue
-            # The reference closest in size to the crossed pulse needs the least rescaling.
-            reference = same.loc[(same["F_m_N"] - crossed.F_m_N).abs().idxmin()]
-            _, ref_time, ref_forces = signals[int(reference["shot"])]
-            ref_force = ref_forces[bead_of["S2"]]
-            force = forces[bead_of[sensor]]
-            baseline, noise = estimate_baseline(time, force)
-            ref_baseline, _ = estimate_baseline(ref_time, ref_force)
-            result = measure_ssw(
-                time,
-                force,
-                crossed.F_m_N,
-                crossed.T_s,
-                crossed.tau_s,
-                ref_time,
-                ref_force,
-                reference["F_m_N"],
-                reference["T_s"],
-                baseline_N=baseline,
-                reference_baseline_N=ref_baseline,
-                noise_N=noise,
-            )
-            for method in SSW_METHODS:
-                value, when, why = result[method]
-                row = _row(base, method, incident.F_m_N, value, when, why)
-                row.update(
-                    {
-                        "ssw_lag_us": (when - crossed.T_s) * 1e6,
-                        "F_crossed_N": crossed.F_m_N,
-                        "reference_shot": int(reference["shot"]),
-                        "template_scale": result["scale"],
-                        "template_misfit_N": result["misfit"],
-                    }
-                )
-                rows.append(row)
+        for sensor in _CROSSED:
+            rows.extend(_sensor_rows(shot, sensor, context))
     return pd.DataFrame(rows, columns=SSW_COLUMNS)
+
+
+def _usable_references(pulses: pd.DataFrame) -> pd.DataFrame:
+    references = pulses[(pulses["role"] == "reference") & (pulses["sensor"] == "S2")]
+    return references[is_ok(references)]
+
+
+def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
+    """The two rows (one per method) of one collision shot at one sensor."""
+    wave, first = _CROSSED[sensor]
+    where = (shot.source, shot.model, shot.N, shot.shot)
+    crossed = context["lookup"].get((*where, sensor, "crossed"))
+    incident = context["lookup"].get((*where, first, "incident"))
+    base = {
+        "source": shot.source,
+        "model": shot.model,
+        "N": shot.N,
+        "shot": shot.shot,
+        "amplitude": shot.amplitude,
+        "sensor": sensor,
+        "bead": context["bead_of"][sensor],
+        "wave": wave,
+    }
+    refs = context["references"]
+    same = refs[
+        (refs["source"] == shot.source)
+        & (refs["model"] == shot.model)
+        & (refs["N"] == shot.N)
+        & (refs["amplitude"] == shot.amplitude)
+    ]
+    reason = ""
+    if crossed is None or not bool(crossed.ok):
+        reason = "crossed pulse not measured"
+    elif incident is None or not bool(incident.ok):
+        reason = "incident pulse not measured"
+    elif same.empty:
+        reason = "no usable reference shot of this amplitude"
+    if reason:
+        return [_row(base, method, math.nan, math.nan, math.nan, reason) for method in SSW_METHODS]
+    # The reference closest in size to the crossed pulse needs the least rescaling.
+    reference = same.loc[(same["F_m_N"] - crossed.F_m_N).abs().idxmin()]
+    result = _measure_at_sensor(shot.shot, sensor, crossed, reference, context)
+    rows = []
+    for method in SSW_METHODS:
+        value, when, why = result[method]
+        row = _row(base, method, incident.F_m_N, value, when, why)
+        row.update(
+            {
+                "ssw_lag_us": (when - crossed.T_s) * 1e6,
+                "F_crossed_N": crossed.F_m_N,
+                "reference_shot": int(reference["shot"]),
+                "template_scale": result["scale"],
+                "template_misfit_N": result["misfit"],
+                "ssw_floor_N": result["floor"],
+                "trailing_min_us": result["trailing_min_s"] * 1e6,
+            }
+        )
+        rows.append(row)
+    return rows
+
+
+def _measure_at_sensor(shot: int, sensor: str, crossed, reference, context: dict) -> dict:
+    """:func:`measure_ssw` on the crossed signal at ``sensor`` against the reference
+    shot's signal at S2 (the same distance from the launching end)."""
+    _, time, forces = context["signals"][shot]
+    _, ref_time, ref_forces = context["signals"][int(reference["shot"])]
+    ref_force = ref_forces[context["bead_of"]["S2"]]
+    force = forces[context["bead_of"][sensor]]
+    baseline, noise = estimate_baseline(time, force)
+    ref_baseline, _ = estimate_baseline(ref_time, ref_force)
+    return measure_ssw(
+        time,
+        force,
+        crossed.F_m_N,
+        crossed.T_s,
+        crossed.tau_s,
+        ref_time,
+        ref_force,
+        reference["F_m_N"],
+        reference["T_s"],
+        baseline_N=baseline,
+        reference_baseline_N=ref_baseline,
+        noise_N=noise,
+    )
 
 
 def _row(base, method, f_m, value, when, reason) -> dict:

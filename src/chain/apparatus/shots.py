@@ -83,6 +83,29 @@ def trace_table(
     return table[list(META_COLUMNS) + list(columns)]
 
 
+def shot_time_step(model: ChainModel, launch_speeds, dt: float | None, record_interval: float):
+    """The RK4 step of :func:`simulate_shots` (and of a re-simulation of its shots), s.
+
+    ``dt`` itself when given; else :func:`chain.physics.simulation.default_time_step` at
+    the fastest launch, shortened so that ``record_interval`` is a whole number of steps.
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain.
+    launch_speeds : sequence of float
+        V0 per amplitude, m/s.
+    dt : float or None
+        An explicit step, s, or None.
+    record_interval : float
+        Time between recorded samples, s.
+    """
+    if dt is not None:
+        return dt
+    dt = default_time_step(model, float(np.max(launch_speeds)))
+    return record_interval / math.ceil(record_interval / dt)
+
+
 def simulate_shots(
     model: ChainModel,
     launch_speeds,
@@ -126,9 +149,7 @@ def simulate_shots(
     speeds = np.asarray(launch_speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size == 0 or np.any(~np.isfinite(speeds)) or np.any(speeds <= 0):
         raise ParameterError(f"launch_speeds must be positive m/s values, got {launch_speeds!r}")
-    if dt is None:
-        dt = default_time_step(model, float(speeds.max()))
-        dt = record_interval / math.ceil(record_interval / dt)
+    dt = shot_time_step(model, speeds, dt, record_interval)
     tables = []
     runs = []
     for offset, (kind, right) in enumerate((("collision", speeds), ("reference", 0.0 * speeds))):

@@ -1,0 +1,433 @@
+"""The secondary solitary wave (SSW) tracked along the chain, contact by contact.
+
+From the contact forces of a simulated collision at every contact (contact k joins
+beads k and k+1), each crossed wave is followed from the collision point to the free
+end it runs to. At every contact downstream of the collision point:
+
+1. **Main pulse.** The crossed pulse is the largest force at that contact after the
+   collision time t_c (the peak time at the contact(s) next to the collision point).
+2. **SSW.** Behind it, past its trailing minimum, the SSW is the first local maximum
+   whose height and prominence both exceed the floor :data:`TRACK_FLOOR` x F_m (F_m the
+   incident amplitude). The floor is a wave size, not a numerical limit: the force error
+   of the integrator (halving the step) is 1e-10 F_m, seven orders below it.
+3. **Born at the collision.** The maximum must trail the main pulse by no more than a
+   wave born at the collision point at the floor amplitude would, (d + BIRTH_BEADS)
+   (TRACK_FLOOR^(-1/6) - 1) beads' worth of the main pulse's transit time (d the
+   distance from the collision point, Eq. 5's F^(1/6) speed law). The small waves that
+   trail each pulse from its launch (born a whole half chain upstream) lag far more.
+4. **Moving in the same direction.** A maximum counts (``separated``) only if it
+   links to one at a neighbouring contact: arriving later at the downstream contact, by
+   no more than :data:`MAX_STEP_RATIO` main-pulse transit times.
+
+A separated SSW is **detached** where the force between it and the crossed pulse (the
+trailing minimum) has fallen below the floor: until then it rides on the crossed
+pulse's tail and is pulled along (up to ~10 % faster than Eq. 5 in a 60-bead chain).
+The speed of the SSW is fitted on the detached contacts of its first run of separated
+contacts that it reaches before the main pulse reaches the last contact (afterwards the
+end beads fly apart and the chain ahead of the SSW unloads; it slows down). Eq. 5 at the
+SSW's own mean amplitude over those contacts gives the speed a solitary wave of that
+size would have (:func:`ssw_speed_table` takes it as a function: this module knows no
+material). In a 120-bead chain the fitted speed is within 2 % of Eq. 5, as close as the
+main pulse's own (Eq. 5 is a long-wavelength approximation).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+import pandas as pd
+from scipy.signal import find_peaks
+
+from chain.errors import ParameterError
+
+#: Least SSW height and prominence, as a fraction of the incident amplitude F_m.
+TRACK_FLOOR = 1e-3
+
+#: Width of the birth region around the collision point, beads (window of rule 3).
+BIRTH_BEADS = 2.0
+
+#: Largest SSW transit time between neighbouring contacts, in main-pulse transit times.
+MAX_STEP_RATIO = 1.5 * TRACK_FLOOR ** (-1.0 / 6.0)
+
+#: Fewest separated contacts for a speed fit (two intervals).
+MIN_SPEED_CONTACTS = 3
+
+WAVES = ("LSTW", "RSTW")
+
+#: Columns of :func:`ssw_track_table` (after ``separated``: extras).
+TRACK_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "shot",
+    "wave",
+    "contact",
+    "time_us",
+    "force_N",
+    "F_m_N",
+    "separated",
+    "detached",
+    "trailing_min_N",
+    "distance_beads",
+    "main_time_us",
+    "main_force_N",
+    "other_time_us",
+)
+
+#: Columns of :func:`ssw_speed_table` (after ``first_separated_contact``: extras).
+SPEED_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "wave",
+    "speed_m_s",
+    "eq5_speed_m_s",
+    "ratio",
+    "first_separated_contact",
+    "distance_beads",
+    "first_detached_contact",
+    "force_N",
+    "F_m_N",
+    "n_contacts",
+    "shot",
+    "n_shots",
+    "n_shots_separated",
+    "ratio_min",
+    "ratio_max",
+)
+
+
+def collision_point(n_beads: int) -> float:
+    """Where two equal waves launched from the ends of N beads meet, in bead units.
+
+    (N + 1) / 2: the middle bead for odd N, the middle contact for even N. Contact k
+    sits at k + 1/2.
+    """
+    return 0.5 * (n_beads + 1)
+
+
+def _downstream(n_beads: int) -> np.ndarray:
+    """Contacts past the collision point for a wave moving to higher bead numbers."""
+    contacts = np.arange(1, n_beads)
+    return contacts[contacts + 0.5 > collision_point(n_beads)]
+
+
+def track_wave(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict:
+    """The SSW behind the wave that runs towards higher contact numbers, one collision.
+
+    Parameters
+    ----------
+    time_s : (S,) array
+        Sample times, s (evenly sampled).
+    contact_force_N : (S, N-1) array
+        Force at contacts 1..N-1, N. For the wave running to lower numbers, pass the
+        contacts reversed (:func:`track_collision` does).
+    floor : float
+        Least SSW height and prominence as a fraction of F_m.
+
+    Returns
+    -------
+    dict
+        ``contact`` (k, downstream of the collision point, outward), ``time_s``,
+        ``force_N`` (SSW maximum, NaN where none), ``separated`` (bool), ``detached``
+        (bool: separated, and the force between it and the crossed pulse below the
+        floor), ``trailing_min_N`` (that force), ``main_time_s``,
+        ``main_force_N`` (the crossed pulse), ``other_time_s`` (the opposite wave's
+        incident peak), ``F_m_N`` (incident amplitude: the peak before t_c at the contact
+        half way from the launching end to the collision point).
+    """
+    time = np.asarray(time_s, dtype=float)
+    force = np.asarray(contact_force_N, dtype=float)
+    if force.ndim != 2 or force.shape[0] != time.size or force.shape[1] < 2:
+        raise ParameterError(f"contact_force_N must be (samples, contacts), got {force.shape}")
+    n_beads = force.shape[1] + 1
+    centre = collision_point(n_beads)
+    near = [k for k in range(1, n_beads) if abs(k + 0.5 - centre) <= 0.5]
+    t_c = float(time[np.argmax(force[:, np.array(near) - 1].max(axis=1))])
+    before, after = time < t_c, time >= t_c
+    f_m = float(force[before, max(1, int(centre // 2)) - 1].max())
+    contacts = _downstream(n_beads)
+    main = np.array([np.flatnonzero(after)[0] + np.argmax(force[after, k - 1]) for k in contacts])
+    steps = np.diff(time[main])
+    step = float(np.median(steps)) if steps.size else math.nan
+    distance = contacts + 0.5 - centre
+    windows = (distance + BIRTH_BEADS) * (floor ** (-1.0 / 6.0) - 1.0) * step
+    found = [
+        _first_bump(force[:, k - 1], index, window, floor * f_m, time)
+        for k, index, window in zip(contacts, main, windows)
+    ]
+    ssw_time = np.array([time[i] if i >= 0 else math.nan for i in found])
+    ssw_force = np.array([force[i, k - 1] if i >= 0 else math.nan for i, k in zip(found, contacts)])
+    trough = np.array(
+        [force[m:i, k - 1].min() if i >= 0 else math.nan for m, i, k in zip(main, found, contacts)]
+    )
+    separated = _linked(ssw_time, step)
+    return {
+        "contact": contacts,
+        "time_s": ssw_time,
+        "force_N": ssw_force,
+        "separated": separated,
+        "detached": separated & (trough <= floor * f_m),
+        "trailing_min_N": trough,
+        "main_time_s": time[main],
+        "main_force_N": force[main, contacts - 1],
+        "other_time_s": np.array(
+            [time[np.argmax(np.where(before, force[:, k - 1], -np.inf))] for k in contacts]
+        ),
+        "F_m_N": f_m,
+        "distance_beads": distance,
+    }
+
+
+def _first_bump(signal, main_index: int, window_s: float, floor_N: float, time) -> int:
+    """Index of the first maximum past the main peak (height and prominence above
+    ``floor_N``) within ``window_s`` of it, or -1."""
+    if not np.isfinite(window_s):
+        return -1
+    segment = signal[main_index:]
+    peaks, _ = find_peaks(segment, height=floor_N, prominence=floor_N)
+    peaks = peaks[time[main_index + peaks] - time[main_index] <= window_s]
+    return int(main_index + peaks[0]) if peaks.size else -1
+
+
+def _linked(ssw_time, step: float) -> np.ndarray:
+    """True where an SSW maximum links to one at a neighbouring contact: later
+    downstream, by at most MAX_STEP_RATIO main-pulse steps (same direction of travel)."""
+    gaps = np.diff(ssw_time)
+    with np.errstate(invalid="ignore"):
+        link = (gaps > 0) & (gaps <= MAX_STEP_RATIO * step)
+    linked = np.zeros(ssw_time.size, dtype=bool)
+    linked[:-1] |= link
+    linked[1:] |= link
+    return linked
+
+
+def track_collision(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict[str, dict]:
+    """Both crossed waves of one collision: ``{"LSTW": ..., "RSTW": ...}``.
+
+    LSTW runs to higher contact numbers; RSTW is tracked on the mirrored chain and its
+    contacts mapped back (k -> N - k). Parameters and values as in :func:`track_wave`.
+    """
+    force = np.asarray(contact_force_N, dtype=float)
+    left = track_wave(time_s, force, floor=floor)
+    right = track_wave(time_s, force[:, ::-1], floor=floor)
+    right["contact"] = force.shape[1] + 1 - right["contact"]
+    return {"LSTW": left, "RSTW": right}
+
+
+def ssw_track_table(
+    time_s,
+    contact_force_N,
+    *,
+    source: str,
+    model: str,
+    shots=None,
+    floor: float = TRACK_FLOOR,
+) -> pd.DataFrame:
+    """The rows of ``ssw_track.csv`` for a batch of collisions of one chain.
+
+    Parameters
+    ----------
+    time_s : (S,) array
+        Sample times, s.
+    contact_force_N : (B, S, N-1) array
+        Contact forces of B collision shots, N (``SimulationResult.contact_force``).
+    source, model : str
+        Values of the ``source`` and ``model`` columns.
+    shots : sequence of int, optional
+        Shot id of each collision (default 0..B-1).
+    floor : float
+        Least SSW height and prominence as a fraction of F_m.
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`TRACK_COLUMNS`; one row per shot, wave and downstream contact;
+        ``time_us``/``force_N`` NaN where no maximum was found, ``separated`` True where
+        the maximum is part of a track.
+    """
+    force = np.asarray(contact_force_N, dtype=float)
+    if force.ndim != 3:
+        raise ParameterError(
+            f"contact_force_N must be (shots, samples, contacts), got {force.shape}"
+        )
+    shots = np.arange(force.shape[0]) if shots is None else np.asarray(shots)
+    frames = []
+    for shot, forces in zip(shots, force):
+        for wave, found in track_collision(time_s, forces, floor=floor).items():
+            frames.append(_track_rows(found, source, model, forces.shape[1] + 1, int(shot), wave))
+    return pd.concat(frames, ignore_index=True)[list(TRACK_COLUMNS)]
+
+
+def _track_rows(found: dict, source, model, n_beads, shot, wave) -> pd.DataFrame:
+    separated = found["separated"]
+    return pd.DataFrame(
+        {
+            "source": source,
+            "model": model,
+            "N": n_beads,
+            "shot": shot,
+            "wave": wave,
+            "contact": found["contact"],
+            "time_us": np.where(separated, found["time_s"] * 1e6, math.nan),
+            "force_N": np.where(separated, found["force_N"], math.nan),
+            "F_m_N": found["F_m_N"],
+            "separated": separated,
+            "detached": found["detached"],
+            "trailing_min_N": np.where(separated, found["trailing_min_N"], math.nan),
+            "distance_beads": found["distance_beads"],
+            "main_time_us": found["main_time_s"] * 1e6,
+            "main_force_N": found["main_force_N"],
+            "other_time_us": found["other_time_s"] * 1e6,
+        }
+    )
+
+
+def shot_speed(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> dict:
+    """SSW speed of one shot and wave from its ``ssw_track.csv`` rows.
+
+    Parameters
+    ----------
+    track : DataFrame
+        The rows of one (shot, wave).
+    eq5_speed : callable
+        Eq. 5: solitary-wave speed (m/s) from its peak contact force (N), e.g.
+        ``lambda f: nesterenko_speed_from_force(f, material, radius)``.
+    spacing_m : float
+        Distance between neighbouring contacts (the bead diameter), m.
+
+    Returns
+    -------
+    dict
+        ``first_separated_contact`` (the first separated contact outward from the
+        collision point, or None), ``distance_beads`` (its distance from it),
+        ``first_detached_contact`` (or None), ``n_contacts`` (of the fit),
+        ``speed_m_s``, ``eq5_speed_m_s``, ``force_N`` (mean SSW maximum over the fit),
+        ``ratio`` (NaN below :data:`MIN_SPEED_CONTACTS` contacts).
+    """
+    rows = track.sort_values("distance_beads")
+    separated = rows["separated"].to_numpy(bool)
+    result = {"first_separated_contact": None, "distance_beads": math.nan, "n_contacts": 0}
+    result["first_detached_contact"] = None
+    result.update(speed_m_s=math.nan, eq5_speed_m_s=math.nan, force_N=math.nan, ratio=math.nan)
+    if not separated.any():
+        return result
+    first = int(np.argmax(separated))
+    stop = first + int(np.argmin(np.append(separated[first:], False)))
+    run = rows.iloc[first:stop]
+    result["first_separated_contact"] = int(rows["contact"].iloc[first])
+    result["distance_beads"] = float(rows["distance_beads"].iloc[first])
+    detached = run[run["detached"].to_numpy(bool)]
+    if not detached.empty:
+        result["first_detached_contact"] = int(detached["contact"].iloc[0])
+    # The chain ahead unloads once the main pulse has reached the last contact.
+    run = detached[detached["time_us"] < rows["main_time_us"].iloc[-1]]
+    result["n_contacts"] = len(run)
+    if len(run) < MIN_SPEED_CONTACTS:
+        return result
+    slope_s = np.polyfit(run["distance_beads"], run["time_us"] * 1e-6, 1)[0]
+    force = float(run["force_N"].mean())
+    result.update(speed_m_s=spacing_m / slope_s, eq5_speed_m_s=float(eq5_speed(force)))
+    result.update(force_N=force, ratio=result["speed_m_s"] / result["eq5_speed_m_s"])
+    return result
+
+
+def ssw_speed_table(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> pd.DataFrame:
+    """The rows of ``ssw_speed.csv``: is the SSW a solitary wave?
+
+    Per shot and wave, the SSW's speed from its arrival times on its first run of
+    separated contacts (:func:`shot_speed`), against Eq. 5's speed for its own mean
+    amplitude. One row per (source, model, N, wave): the shot with the median ratio
+    (lower median), with ``ratio_min``/``ratio_max`` over the shots that have a speed,
+    ``n_shots`` and ``n_shots_separated`` (shots with any separated contact).
+
+    Parameters
+    ----------
+    track : DataFrame
+        ``ssw_track.csv`` rows (:func:`ssw_track_table`).
+    eq5_speed : callable
+        Eq. 5, peak force (N) -> speed (m/s).
+    spacing_m : float
+        Contact spacing (bead diameter), m.
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`SPEED_COLUMNS`; speeds in m/s, ``ratio`` = speed / Eq. 5.
+    """
+    rows = []
+    for key, group in track.groupby(["source", "model", "N", "wave"], sort=True):
+        shots = [
+            {"shot": int(shot), "F_m_N": float(rows_["F_m_N"].iloc[0])}
+            | shot_speed(rows_, eq5_speed, spacing_m)
+            for shot, rows_ in group.groupby("shot", sort=True)
+        ]
+        rows.append(_speed_row(dict(zip(["source", "model", "N", "wave"], key)), shots))
+    table = pd.DataFrame(rows, columns=SPEED_COLUMNS)
+    for column in ("first_separated_contact", "first_detached_contact"):
+        table[column] = table[column].astype("Int64")
+    return table
+
+
+def _speed_row(base: dict, shots: list[dict]) -> dict:
+    with_speed = sorted((s for s in shots if np.isfinite(s["ratio"])), key=lambda s: s["ratio"])
+    separated = [s for s in shots if s["first_separated_contact"] is not None]
+    if with_speed:
+        chosen = with_speed[(len(with_speed) - 1) // 2]
+    elif separated:
+        chosen = min(separated, key=lambda s: s["distance_beads"])
+    else:
+        chosen = shots[0]
+    ratios = [s["ratio"] for s in with_speed]
+    return base | {
+        **{name: chosen[name] for name in SPEED_COLUMNS if name in chosen},
+        "n_shots": len(shots),
+        "n_shots_separated": len(separated),
+        "ratio_min": min(ratios, default=math.nan),
+        "ratio_max": max(ratios, default=math.nan),
+    }
+
+
+def representative_shot(track: pd.DataFrame, force_N: float, index: int | None = None) -> int:
+    """The shot shown for one chain: amplitude ``index`` if given, else the shot whose
+    incident amplitude F_m is closest to ``force_N`` (N).
+
+    Parameters
+    ----------
+    track : DataFrame
+        ``ssw_track.csv`` rows of one chain and model.
+    force_N : float
+        Wanted incident amplitude, N.
+    index : int, optional
+        Amplitude index (the shot id of a collision, 0..A-1).
+    """
+    shots = track.drop_duplicates("shot").sort_values("shot")
+    if index is not None:
+        if index not in set(shots["shot"]):
+            raise ParameterError(f"amplitude index {index} not among shots {list(shots['shot'])}")
+        return int(index)
+    return int(shots.loc[(shots["F_m_N"] - force_N).abs().idxmin(), "shot"])
+
+
+def field_table(time_s, contact_force_N, *, shot: int) -> pd.DataFrame:
+    """Contact forces of one collision over time, for the space-time figure.
+
+    Parameters
+    ----------
+    time_s : (S,) array
+        Sample times, s.
+    contact_force_N : (S, N-1) array
+        Forces at contacts 1..N-1, N.
+    shot : int
+        Shot id written in the ``shot`` column.
+
+    Returns
+    -------
+    DataFrame
+        ``shot, t_us, contact_1 .. contact_<N-1>`` (N).
+    """
+    force = np.asarray(contact_force_N, dtype=float)
+    columns = {f"contact_{k}": force[:, k - 1] for k in range(1, force.shape[1] + 1)}
+    return pd.DataFrame({"shot": shot, "t_us": np.asarray(time_s) * 1e6, **columns})
