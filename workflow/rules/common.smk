@@ -177,6 +177,7 @@ def figure_names():
         "fig3_simulation_traces",
         "fig4_delay_vs_force",
         "fig5_ssw_vs_force",
+        "ssw_spacetime",
     ]
     if EXPERIMENT_PARTS:
         names.insert(1, "fig2_experiment_traces")
@@ -188,7 +189,15 @@ def figure_names():
 
 
 def final_targets(wildcards=None):
-    tables = ["pulses", "delays", "delay_fits", "ssw", "ssw_fits", "ssw_track", "ssw_speed"]
+    tables = [
+        "pulses",
+        "delays",
+        "delay_fits",
+        "ssw",
+        "ssw_fits",
+        "ssw_track",
+        "ssw_speed",
+    ]
     return (
         [f"{TABLES}/{table}.csv" for table in tables]
         + [path for name in figure_names() for path in figure(name)]

@@ -131,3 +131,27 @@ rule fig_parity_ssw_vs_N:
         experiment_label=experiment_label,
     script:
         "../scripts/fig_parity_ssw_vs_N.py"
+
+
+# The SSW along the chain (issue 13): field of one collision per chain of the first
+# conservative model (where the SSW is a clean wave), or of Fig. 3's model if none.
+SPACETIME_MODEL = CONSERVATIVE[0] if CONSERVATIVE else config["figures"]["traces_model"]
+
+
+rule fig_ssw_spacetime:
+    input:
+        fields=[f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in TRACES_N],
+        track=f"{TABLES}/ssw_track.csv",
+        lib=code("fig_ssw_spacetime"),
+    output:
+        **figure_outputs("ssw_spacetime"),
+    log:
+        f"{LOGS}/figures/ssw_spacetime.log",
+    benchmark:
+        f"{BENCH}/figures/ssw_spacetime.tsv"
+    conda:
+        ENV
+    params:
+        model=SPACETIME_MODEL,
+    script:
+        "../scripts/fig_ssw_spacetime.py"

@@ -38,5 +38,7 @@ track = ssw_track_table(
 log.info("%d of %d contacts separated", track["separated"].sum(), len(track))
 shot = representative_shot(track, p.representative_force_N, p.representative_index)
 write_csv_atomic(track, snakemake.output.track)
-write_csv_atomic(field_table(result.time, result.contact_force[shot], shot=shot), snakemake.output.field)
+write_csv_atomic(
+    field_table(result.time, result.contact_force[shot], shot=shot), snakemake.output.field
+)
 log.info("field of shot %d written", shot)

@@ -1,0 +1,160 @@
+"""Figure ssw_spacetime: the secondary solitary wave (SSW) seen along the chain.
+
+Left, one panel per chain: the contact force of one collision over time (x) and contact
+index (y), divided by the incident amplitude F_m, on a logarithmic colour scale from the
+tracking floor (0.1 % of F_m, white below) so that a 1 % wave shows. Over it, the two
+main waves (incident dashed, crossed solid: peak times at each contact) and the tracked
+SSW (crosses, where it is separated). Right: the SSW amplitude over F_m against the
+distance from the collision point, every shot of every model and chain; a series that
+is never separated says so in the legend. Everything drawn comes from
+``ssw_track.csv`` and the field file of the ``ssw_track`` rule; nothing is computed here.
+"""
+
+from __future__ import annotations
+
+import matplotlib as mpl
+import numpy as np
+import pandas as pd
+from matplotlib.colors import LogNorm
+from matplotlib.figure import Figure
+
+from chain.analysis.ssw_track import TRACK_FLOOR
+from chain.report.figures import (
+    LSTW_COLOR,
+    RSTW_COLOR,
+    STYLE,
+    chain_marker,
+    model_colors,
+)
+
+#: Upper end of the colour scale, in F_m (the collision peak is ~1.75 F_m).
+COLOR_MAX = 2.0
+#: Colours of the waves, as in Fig. 2/3 (dark, to show on the bright pulses).
+WAVE_COLORS = {"LSTW": LSTW_COLOR, "RSTW": RSTW_COLOR}
+SSW_COLOR = "#00e676"
+
+
+def field_image(field: pd.DataFrame, f_m_N: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time (us), contact numbers and force / F_m (contacts x samples) of a field file,
+    NaN below the tracking floor (drawn white)."""
+    columns = [c for c in field.columns if c.startswith("contact_")]
+    contacts = np.array([int(c.split("_")[1]) for c in columns])
+    ratio = field[columns].to_numpy(float).T / f_m_N
+    return field["t_us"].to_numpy(float), contacts, np.where(ratio >= TRACK_FLOOR, ratio, np.nan)
+
+
+def draw_field(ax, time_us, contacts, ratio):
+    """Contact force / F_m over time and contact index, log colours. Returns the mesh."""
+    norm = LogNorm(vmin=TRACK_FLOOR, vmax=COLOR_MAX)
+    mesh = ax.pcolormesh(
+        time_us, contacts, ratio, norm=norm, cmap="magma", shading="nearest", rasterized=True
+    )
+    ax.set_xlabel("time (µs)")
+    ax.set_ylabel("contact k (beads k, k+1)")
+    return mesh
+
+
+def draw_waves(ax, track: pd.DataFrame) -> None:
+    """Main waves (incident dashed, crossed solid) and the separated SSW of one shot.
+
+    A wave's rows hold its crossed pulse downstream of the collision point and, at the
+    same contacts, the incident pulse of the other wave (``other_time_us``)."""
+    other = {"LSTW": "RSTW", "RSTW": "LSTW"}
+    for wave, rows in track.groupby("wave", sort=True):
+        incident = WAVE_COLORS.get(other.get(wave), "white")
+        ax.plot(rows["other_time_us"], rows["contact"], color=incident, ls="--", lw=0.7)
+        ax.plot(rows["main_time_us"], rows["contact"], color=WAVE_COLORS.get(wave), lw=0.7)
+        separated = rows[rows["separated"].astype(bool)]
+        ax.plot(
+            separated["time_us"],
+            separated["contact"],
+            ls="none",
+            marker="+",
+            ms=5,
+            mew=1.0,
+            color=SSW_COLOR,
+        )
+
+
+def draw_ssw_vs_distance(ax, series: list[dict]) -> None:
+    """SSW / F_m against distance from the collision point, one entry per series
+    (``label``, ``distance``, ``ratio``, ``marker``, ``color``, ``filled``); a series
+    without points gets a legend entry only."""
+    for item in series:
+        ax.plot(
+            item["distance"],
+            item["ratio"],
+            ls="none",
+            marker=item["marker"],
+            ms=4,
+            color=item["color"],
+            mfc=item["color"] if item["filled"] else "none",
+            mew=0.9,
+            label=item["label"],
+        )
+    ax.set_xlabel("distance from the collision point (beads)")
+    ax.set_ylabel("SSW amplitude / F$_m$")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=6, frameon=False)
+
+
+def ssw_series(track: pd.DataFrame) -> list[dict]:
+    """The right panel's series: one per model and chain (LSTW; RSTW is its mirror)."""
+    rows = track[track["wave"] == "LSTW"]
+    colors = model_colors(list(dict.fromkeys(rows["model"])))
+    chains = sorted({int(n) for n in rows["N"]})
+    series = []
+    for (model, n), group in rows.groupby(["model", "N"], sort=True):
+        separated = group[group["separated"].astype(bool)]
+        marker = chain_marker(int(n), chains)
+        label = f"{model}, N = {n}"
+        if separated.empty:
+            label += ": never separated"
+        series.append(
+            {
+                "label": label,
+                "distance": separated["distance_beads"].to_numpy(float),
+                "ratio": (separated["force_N"] / separated["F_m_N"]).to_numpy(float),
+                "marker": "s" if marker == "x" else marker,
+                "color": colors[model],
+                "filled": marker != "x",
+            }
+        )
+    return series
+
+
+def fig_ssw_spacetime(fields: dict[int, pd.DataFrame], track: pd.DataFrame, model: str) -> Figure:
+    """The space-time figure: field of one collision per chain of ``model``, and SSW
+    amplitude against distance for every model and chain.
+
+    Parameters
+    ----------
+    fields : dict
+        N -> field table of the shown collision (``<model>_N<N>_field.csv``).
+    track : DataFrame
+        ``ssw_track.csv``.
+    model : str
+        Model of the fields.
+    """
+    with mpl.rc_context(STYLE):
+        fig = Figure(figsize=(3.0 * len(fields) + 3.2, 3.4), layout="constrained")
+        axes = fig.subplots(1, len(fields) + 1, width_ratios=[1.0] * len(fields) + [1.1])
+        mesh = None
+        for ax, (n, field) in zip(axes, sorted(fields.items())):
+            shot = int(field["shot"].iloc[0])
+            rows = track[(track["model"] == model) & (track["N"] == n) & (track["shot"] == shot)]
+            f_m = float(rows["F_m_N"].iloc[0])
+            mesh = draw_field(ax, *field_image(field, f_m))
+            draw_waves(ax, rows)
+            ax.set_title(f"{model}, N = {n}, F$_m$ = {f_m:.0f} N", loc="left")
+        fig.colorbar(mesh, ax=list(axes[:-1]), label="contact force / F$_m$", shrink=0.9)
+        draw_ssw_vs_distance(axes[-1], ssw_series(track))
+        axes[-1].set_title("SSW where separated (all shots)", loc="left")
+        handles = [
+            mpl.lines.Line2D([], [], color=WAVE_COLORS["LSTW"], label="LSTW"),
+            mpl.lines.Line2D([], [], color=WAVE_COLORS["RSTW"], label="RSTW"),
+            mpl.lines.Line2D([], [], color="0.4", ls="--", label="incident (before crossing)"),
+            mpl.lines.Line2D([], [], color="0.4", ls="-", label="crossed (after)"),
+            mpl.lines.Line2D([], [], color=SSW_COLOR, ls="none", marker="+", label="SSW tracked"),
+        ]
+        fig.legend(handles=handles, loc="outside lower left", ncol=5, fontsize=6, frameon=False)
+    return fig
