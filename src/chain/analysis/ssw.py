@@ -455,3 +455,63 @@ def ssw_fit_table(ssw: pd.DataFrame, method: str = "residual") -> pd.DataFrame:
             }
         )
     return pd.DataFrame(rows, columns=SSW_FIT_COLUMNS)
+
+
+#: Columns of :func:`ssw_resolution_table` (summary key ``ssw_resolved``).
+RESOLUTION_COLUMNS = ("source", "model", "N", "sensor", "resolved", "n_resolved", "n_total")
+
+
+def ssw_resolution_table(ssw: pd.DataFrame, method: str = "residual") -> pd.DataFrame:
+    """Is the SSW resolved at each sensor? One row per (source, model, N, sensor).
+
+    Parameters
+    ----------
+    ssw : DataFrame
+        ``ssw.csv`` rows (:func:`ssw_table`).
+    method : {"residual", "peak"}
+        Which measurement's rows to count.
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`RESOLUTION_COLUMNS`: ``n_resolved`` of ``n_total`` collision shots
+        have a value (``ok``); ``resolved`` is True when at least half of them do.
+    """
+    rows = []
+    chosen = ssw[ssw["method"] == method]
+    for key, group in chosen.groupby(["source", "model", "N", "sensor"], sort=True):
+        n_resolved, n_total = int(is_ok(group).sum()), len(group)
+        rows.append(
+            dict(zip(RESOLUTION_COLUMNS[:4], key))
+            | {"resolved": n_total > 0 and 2 * n_resolved >= n_total}
+            | {"n_resolved": n_resolved, "n_total": n_total}
+        )
+    table = pd.DataFrame(rows, columns=RESOLUTION_COLUMNS)
+    table["N"] = table["N"].astype(int)
+    return table
+
+
+def ssw_parity_table(fits: pd.DataFrame, even: int = 26, odd: int = 25) -> pd.DataFrame:
+    """SSW slope of the even chain over the odd one's, per source and model (the paper's
+    claim: larger when the waves cross at a contact). NaN where either has no fit.
+
+    Parameters
+    ----------
+    fits : DataFrame
+        ``ssw_fits.csv`` rows (:func:`ssw_fit_table`).
+    even, odd : int
+        The two chains compared (the paper's 26 and 25).
+
+    Returns
+    -------
+    DataFrame
+        ``source, model, ratio`` for every (source, model) with both chains.
+    """
+    rows = []
+    numeric = fits[fits["N"].astype(str).isin([str(even), str(odd)])]
+    for (source, model), group in numeric.groupby(["source", "model"], sort=True):
+        slopes = dict(zip(group["N"].astype(int), group["slope"].astype(float)))
+        if even in slopes and odd in slopes:
+            ratio = slopes[even] / slopes[odd] if slopes[odd] else math.nan
+            rows.append({"source": source, "model": model, "ratio": ratio})
+    return pd.DataFrame(rows, columns=["source", "model", "ratio"])

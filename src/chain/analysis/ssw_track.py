@@ -431,3 +431,37 @@ def field_table(time_s, contact_force_N, *, shot: int) -> pd.DataFrame:
     force = np.asarray(contact_force_N, dtype=float)
     columns = {f"contact_{k}": force[:, k - 1] for k in range(1, force.shape[1] + 1)}
     return pd.DataFrame({"shot": shot, "t_us": np.asarray(time_s) * 1e6, **columns})
+
+
+#: Columns of :func:`separation_table` (summary key ``ssw_separation``).
+SEPARATION_COLUMNS = (
+    "model",
+    "N",
+    "wave",
+    "first_separated_contact",
+    "distance_beads",
+    "speed_ratio",
+    "n_shots_separated",
+    "n_shots",
+)
+
+
+def separation_table(speed: pd.DataFrame) -> pd.DataFrame:
+    """Where the SSW separates from the crossed pulse, per model, chain and wave.
+
+    Parameters
+    ----------
+    speed : DataFrame
+        ``ssw_speed.csv`` rows (:func:`ssw_speed_table`).
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`SEPARATION_COLUMNS`: the first separated contact (NA if never),
+        its distance from the collision point in beads, and the SSW's speed over Eq. 5's
+        (NaN where it never detaches over enough contacts to fit a speed), for the
+        shot of :func:`ssw_speed_table`; ``n_shots_separated`` of ``n_shots`` shots
+        separate at all.
+    """
+    table = speed.rename(columns={"ratio": "speed_ratio"})
+    return table[list(SEPARATION_COLUMNS)].reset_index(drop=True)
