@@ -54,6 +54,20 @@ def test_a_run_matches_its_own_reference():
     assert headline.compare_with_reference(headline.headline_numbers(summary), reference) == []
 
 
+def test_a_slope_with_no_resolved_points_is_null_and_must_stay_so():
+    """An SSW fit with no resolved points (slope null) makes a reference with a null; a
+    later run that does give a number is reported, and so is the reverse."""
+    summary = _summary()
+    summary["ssw_fits"][0]["slope"] = None
+    reference = headline.reference_from_summary(summary, "test")
+    assert reference["values"]["ssw_slope/simulation/elastic/N=25/residual"] is None
+    assert headline.compare_with_reference(headline.headline_numbers(summary), reference) == []
+    resolved = copy.deepcopy(summary)
+    resolved["ssw_fits"][0]["slope"] = 0.02
+    failures = headline.compare_with_reference(headline.headline_numbers(resolved), reference)
+    assert failures and "no value" in failures[0]
+
+
 @pytest.mark.parametrize(
     ("change", "fragment"),
     [

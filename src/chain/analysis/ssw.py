@@ -91,6 +91,7 @@ SSW_COLUMNS = (
     "template_misfit_N",
     "ssw_floor_N",
     "trailing_min_us",
+    "ssw_candidate_N",
 )
 
 #: Columns of :func:`ssw_fit_table`.
@@ -165,9 +166,10 @@ def measure_ssw(
     -------
     dict
         ``{"residual": (ssw_N, time_s, reason), "peak": (...), "scale": a, "misfit": N,
-        "floor": N, "trailing_min_s": s}``; ``reason`` is "" when the SSW is resolved
-        (values NaN otherwise); ``misfit`` is the largest smoothed |signal - template| on the
-        rising edge, ``floor`` the least resolved residual, ``trailing_min_s`` the time of
+        "floor": N, "trailing_min_s": s, "candidate": N}``; ``reason`` is "" when the SSW
+        is resolved (values NaN otherwise); ``misfit`` is the largest smoothed
+        |signal - template| on the rising edge, ``floor`` the least resolved residual,
+        ``candidate`` the residual maximum read, resolved or not, ``trailing_min_s`` the time of
         the crossed pulse's trailing minimum (NaN without a distinct bump).
     """
     time = np.asarray(time_s, dtype=float)
@@ -175,7 +177,7 @@ def measure_ssw(
     ref_signal = np.asarray(reference_force_N, dtype=float) - reference_baseline_N
     nan = (math.nan, math.nan, "crossed pulse not sampled")
     result = {"residual": nan, "peak": nan, "scale": math.nan, "misfit": math.nan}
-    result.update(floor=math.nan, trailing_min_s=math.nan)
+    result.update(floor=math.nan, trailing_min_s=math.nan, candidate=math.nan)
     spline = CubicSpline(np.asarray(reference_time_s, dtype=float), ref_signal, extrapolate=False)
     aligned = _align_template(
         time,
@@ -205,7 +207,7 @@ def measure_ssw(
         return result
     low, peak, far = bump
     best = low + int(np.argmax(residual[low : far + 1]))
-    result["trailing_min_s"] = float(time[low])
+    result.update(trailing_min_s=float(time[low]), candidate=float(residual[best]))
     if residual[best] > floor:
         result["residual"] = (float(residual[best]), float(time[best]), "")
         result["peak"] = (float(smooth(signal)[peak]), float(time[peak]), "")
@@ -291,7 +293,9 @@ def ssw_table(
         (same origin as ``t_s``), ``ssw_lag_us`` its delay after the crossed pulse's T,
         ``template_scale`` the force ratio a of the template to the reference,
         ``template_misfit_N`` the largest smoothed |signal - template| on the rising edge,
-        ``ssw_floor_N`` the least resolved value, ``trailing_min_us`` the time of the
+        ``ssw_floor_N`` the least resolved value, ``ssw_candidate_N`` the residual
+        maximum behind the trailing minimum whether or not it clears the floor (NaN
+        without a distinct bump), ``trailing_min_us`` the time of the
         crossed pulse's trailing minimum. Unresolved rows: ``ok`` False, reason
         :data:`NOT_RESOLVED`, ``ssw_N`` NaN.
     """
@@ -375,6 +379,7 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
                 "template_misfit_N": result["misfit"],
                 "ssw_floor_N": result["floor"],
                 "trailing_min_us": result["trailing_min_s"] * 1e6,
+                "ssw_candidate_N": result["candidate"],
             }
         )
         rows.append(row)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from chain.analysis.delays import DELAY_FIT_COLUMNS
 from chain.analysis.ssw import SSW_FIT_COLUMNS
+from chain.analysis.ssw_track import SPEED_COLUMNS, TRACK_COLUMNS
 
 #: Files of the results contract (design.md), relative to results/<run_name>/.
 CONTRACT_FIGURES = (
@@ -23,6 +24,7 @@ CONTRACT_FIGURES = (
     "fig3_simulation_traces",
     "fig4_delay_vs_force",
     "fig5_ssw_vs_force",
+    "ssw_spacetime",
 )
 EXPERIMENT_FIGURES = ("fig2_experiment_traces",)
 #: Contract columns of each table (the tables have more after these).
@@ -32,6 +34,8 @@ CONTRACT_TABLES = {
     "delay_fits.csv": DELAY_FIT_COLUMNS[: DELAY_FIT_COLUMNS.index("n_points") + 1],
     "ssw.csv": ("source", "model", "N", "F_m_N", "ssw_N"),
     "ssw_fits.csv": SSW_FIT_COLUMNS[: SSW_FIT_COLUMNS.index("n_points") + 1],
+    "ssw_track.csv": TRACK_COLUMNS[: TRACK_COLUMNS.index("separated") + 1],
+    "ssw_speed.csv": SPEED_COLUMNS[: SPEED_COLUMNS.index("first_separated_contact") + 1],
 }
 SUMMARY_KEYS = ("run_name", "constants", "paper", "max_energy_drift", "delay_fits", "ssw_fits")
 
@@ -188,5 +192,9 @@ def reference_from_summary(summary: dict, note: str) -> dict:
         "note": note,
         "run_name": summary["run_name"],
         "tolerances": DEFAULT_TOLERANCES,
-        "values": {k: (None if not math.isfinite(v) else v) for k, v in sorted(numbers.items())},
+        # A number the run could not give (a fit with no usable points) is JSON null.
+        "values": {
+            k: (None if v is None or not math.isfinite(v) else v)
+            for k, v in sorted(numbers.items())
+        },
     }
