@@ -477,3 +477,48 @@ def test_model_colors_and_markers():
     assert style.chain_marker(25) == "o" and style.chain_marker(26) == "x"
     assert style.chain_marker(20, [20, 21]) != style.chain_marker(21, [20, 21])
     assert math.isfinite(style.PNG_DPI)
+
+
+# ---- SSW markers: on the SSW's maximum, or "not resolved" ----------------------------
+
+
+def test_fig3_ssw_marker_points_at_the_ssw_maximum(trace_inputs):
+    traces, pulses, ssw = trace_inputs
+    fig = fig3_simulation_traces(traces, pulses, ssw, model="elastic", representative_force_N=280)
+    t_ssw = (T_CROSSED + 1.2 * TAU) * 1e6
+    for ax in (a for a in fig.get_axes() if a.get_title(loc="left")):
+        inset = ax.child_axes[0]
+        signal, marker = inset.get_lines()[-2], inset.get_lines()[-1]
+        assert marker.get_marker() == "v"
+        assert marker.get_xdata()[0] == pytest.approx(t_ssw)
+        # Just above the signal at that time (the bump), not at the top of the inset.
+        level = np.interp(t_ssw, signal.get_xdata(), signal.get_ydata())
+        assert level < marker.get_ydata()[0] < level + 0.1 * inset.get_ylim()[1]
+
+
+def test_fig3_says_when_the_ssw_is_not_resolved(trace_inputs):
+    traces, pulses, ssw = trace_inputs
+    unresolved = ssw.assign(ok=False, ssw_N=math.nan, ssw_time_us=math.nan)
+    fig = fig3_simulation_traces(traces, pulses, unresolved, model="elastic")
+    insets = [inset for ax in fig.get_axes() for inset in ax.child_axes]
+    assert len(insets) == 4
+    for inset in insets:
+        assert any("SSW not resolved" in t.get_text() for t in inset.texts)
+        assert not any(line.get_marker() == "v" for line in inset.get_lines())
+
+
+def test_fig5_series_without_resolved_points_says_so_in_the_legend():
+    ssw, fits = ssw_tables()
+    gone = (ssw["source"] == "simulation") & (ssw["N"] == 26)
+    ssw.loc[gone, "ok"] = False
+    fig = fig5_ssw_vs_force(ssw, fits)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    empty = [label for label in labels if "not resolved" in label]
+    assert empty and all("N = 26" in label and "(0 of" in label for label in empty)
+    ax = fig.get_axes()[0]
+    drawn = sum(len(line.get_xdata()) for line in ax.get_lines() if line.get_marker() != "None")
+    assert drawn == int((~gone).sum())
+    # Nothing resolved anywhere: empty axes that say so.
+    ssw["ok"] = False
+    fig = fig5_ssw_vs_force(ssw, fits)
+    assert any("not resolved" in t.get_text() for t in fig.get_axes()[0].texts)

@@ -6,7 +6,7 @@ import pandas as pd
 from _logging import start
 
 from chain.report.fig_ssw_spacetime import fig_ssw_spacetime
-from chain.report.figures import save_figure
+from chain.report.style import save_figure
 
 log = start(snakemake)
 fields = {}

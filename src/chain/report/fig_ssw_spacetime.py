@@ -19,19 +19,20 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from chain.analysis.ssw_track import TRACK_FLOOR
-from chain.report.figures import (
+from chain.report.style import (
     LSTW_COLOR,
     RSTW_COLOR,
     STYLE,
     chain_marker,
     model_colors,
+    new_figure,
 )
 
 #: Upper end of the colour scale, in F_m (the collision peak is ~1.75 F_m).
 COLOR_MAX = 2.0
 #: Colours of the waves, as in Fig. 2/3 (dark, to show on the bright pulses).
 WAVE_COLORS = {"LSTW": LSTW_COLOR, "RSTW": RSTW_COLOR}
-SSW_COLOR = "#00e676"
+TRACK_COLOR = "#00e676"
 
 
 def field_image(field: pd.DataFrame, f_m_N: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -72,7 +73,7 @@ def draw_waves(ax, track: pd.DataFrame) -> None:
             marker="+",
             ms=5,
             mew=1.0,
-            color=SSW_COLOR,
+            color=TRACK_COLOR,
         )
 
 
@@ -135,8 +136,8 @@ def fig_ssw_spacetime(fields: dict[int, pd.DataFrame], track: pd.DataFrame, mode
     model : str
         Model of the fields.
     """
+    fig = new_figure(3.0 * len(fields) + 3.2, 3.4)
     with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(3.0 * len(fields) + 3.2, 3.4), layout="constrained")
         axes = fig.subplots(1, len(fields) + 1, width_ratios=[1.0] * len(fields) + [1.1])
         mesh = None
         for ax, (n, field) in zip(axes, sorted(fields.items())):
@@ -154,7 +155,7 @@ def fig_ssw_spacetime(fields: dict[int, pd.DataFrame], track: pd.DataFrame, mode
             mpl.lines.Line2D([], [], color=WAVE_COLORS["RSTW"], label="RSTW"),
             mpl.lines.Line2D([], [], color="0.4", ls="--", label="incident (before crossing)"),
             mpl.lines.Line2D([], [], color="0.4", ls="-", label="crossed (after)"),
-            mpl.lines.Line2D([], [], color=SSW_COLOR, ls="none", marker="+", label="SSW tracked"),
+            mpl.lines.Line2D([], [], color=TRACK_COLOR, ls="none", marker="+", label="SSW tracked"),
         ]
         fig.legend(handles=handles, loc="outside lower left", ncol=5, fontsize=6, frameon=False)
     return fig

@@ -233,12 +233,16 @@ def _crossed_peak(time, force, split, times) -> tuple[float, float, float]:
 
 def draw_ssw_inset(ax, time, force, split, times, marker, style, template):
     """Zoom on the crossed pulse's trailing edge, where the secondary solitary wave (SSW)
-    rides at the paper's sensor positions: the crossed pulse (``style``: colour, dash),
-    the reference pulse ``template`` (time s, force N, fitted (T, tau, F_m) or None)
-    shifted and scaled onto it (peak on peak), and the SSW ``marker`` (time µs,
-    amplitude N) of :mod:`chain.analysis.ssw` at its time with its amplitude."""
+    follows it: the crossed pulse (``style``: colour, dash), the reference pulse
+    ``template`` (time s, force N, fitted (T, tau, F_m) or None) shifted and scaled onto
+    it (peak on peak), and the SSW ``marker`` (time µs, amplitude N) of
+    :mod:`chain.analysis.ssw`: a triangle just above the signal at the SSW's maximum (a
+    bump behind the crossed pulse's trailing minimum), or, where the analysis found none
+    resolved (``marker`` None), the words "SSW not resolved at this sensor"."""
     t_cross, f_cross, tau = _crossed_peak(time, force, split, times)
     start, stop = t_cross - 0.6 * tau, t_cross + 3.5 * tau
+    if marker:
+        stop = max(stop, marker[0] / MICRO + tau)
     top = min(f_cross, max(0.12 * f_cross, 2.5 * marker[1] if marker else 0.0))
     box = ax.inset_axes(inset_bounds(ax))
     window = (time >= start) & (time <= stop)
@@ -246,13 +250,15 @@ def draw_ssw_inset(ax, time, force, split, times, marker, style, template):
         _draw_template(box, template, times, t_cross, f_cross, start, stop)
     box.plot(time[window] * MICRO, force[window], color=style[0], ls=style[1], lw=1.0)
     if marker:
-        box.plot(marker[0], 0.93 * top, marker="v", color=SSW_COLOR, ms=4, ls="none")
+        _draw_ssw_marker(box, time, force, marker, top, tau)
+    else:
         box.text(
-            marker[0] + 0.25 * tau * MICRO,
-            0.93 * top,
-            f"SSW {marker[1]:.2g} N",
-            ha="left",
-            va="center",
+            0.97,
+            0.9,
+            "SSW not resolved\nat this sensor",
+            transform=box.transAxes,
+            ha="right",
+            va="top",
             fontsize=5.5,
             color=SSW_COLOR,
         )
@@ -261,6 +267,21 @@ def draw_ssw_inset(ax, time, force, split, times, marker, style, template):
     box.tick_params(labelsize=5)
     box.set_title("crossed pulse, trailing edge", fontsize=5.5, pad=1.5)
     box.spines[["top", "right"]].set_visible(True)
+
+
+def _draw_ssw_marker(box, time, force, marker, top, tau) -> None:
+    """A triangle pointing down at the signal where the SSW peaks, and its amplitude."""
+    level = float(np.interp(marker[0] / MICRO, time, force)) + 0.08 * top
+    box.plot(marker[0], level, marker="v", color=SSW_COLOR, ms=4, ls="none")
+    box.text(
+        marker[0] + 0.25 * tau * MICRO,
+        level,
+        f"SSW {marker[1]:.2g} N",
+        ha="left",
+        va="center",
+        fontsize=5.5,
+        color=SSW_COLOR,
+    )
 
 
 def _draw_template(box, template, times, t_cross, f_cross, start, stop) -> None:
