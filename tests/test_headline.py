@@ -44,6 +44,9 @@ def _summary() -> dict:
                 "method": "residual",
             }
         ],
+        "ssw_resolved": [],
+        "ssw_separation": [],
+        "ssw_parity_ratio": [],
     }
 
 

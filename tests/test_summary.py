@@ -282,3 +282,74 @@ def test_no_experiment_no_selection_rows(summary):
     text = summary_markdown(summary)
     assert "acceptance protocol" not in text
     assert summary["selection"] == [] and summary["experiment_tolerance"] is None
+
+
+def test_ssw_keys_and_rows():
+    # One resolved shot of two at S2 of N = 26, none at N = 25; the track separates
+    # for N = 26 only.
+    ssw = pd.DataFrame(
+        {
+            "source": "simulation",
+            "model": "elastic",
+            "N": [25, 25, 26, 26],
+            "sensor": "S2",
+            "method": "residual",
+            "ok": [False, False, True, False],
+            "reason": ["not resolved at the sensor", "not resolved at the sensor", "", "x"],
+            "F_m_N": 100.0,
+            "ssw_N": [math.nan, math.nan, 2.0, math.nan],
+        }
+    )
+    fits = ssw_fits().assign(slope=[math.nan, 0.02], n_points=[0, 1])
+    speed = pd.DataFrame(
+        {
+            "source": "simulation",
+            "model": "elastic",
+            "N": [25, 26],
+            "wave": "LSTW",
+            "ratio": [math.nan, 1.02],
+            "first_separated_contact": pd.array([pd.NA, 17], dtype="Int64"),
+            "distance_beads": [math.nan, 4.0],
+            "n_shots_separated": [0, 12],
+            "n_shots": [12, 12],
+        }
+    )
+    summary = build_summary(
+        run_name="paper",
+        material="steel_100C6",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=fits,
+        ssw=ssw,
+        ssw_speed=speed,
+    )
+    resolved = {row["N"]: row for row in summary["ssw_resolved"]}
+    assert resolved[25] == {
+        "source": "simulation",
+        "model": "elastic",
+        "N": 25,
+        "sensor": "S2",
+        "resolved": False,
+        "n_resolved": 0,
+        "n_total": 2,
+    }
+    assert resolved[26]["resolved"] and resolved[26]["n_resolved"] == 1
+    separation = {row["N"]: row for row in summary["ssw_separation"]}
+    assert separation[25]["first_separated_contact"] is None
+    assert separation[26]["first_separated_contact"] == 17
+    assert separation[26]["distance_beads"] == 4.0 and separation[26]["speed_ratio"] == 1.02
+    assert summary["ssw_parity_ratio"] == [
+        {"source": "simulation", "model": "elastic", "ratio": None}
+    ]
+    json.loads(summary_json(summary))  # NaN-free
+    text = summary_markdown(summary)
+    assert (
+        "| SSW resolved at S2, simulation, elastic, N = 25 | yes (Fig. 2, 3 C/D) | no (0 of 2"
+        in text
+    )
+    assert "contact 17 (4 beads from the collision point)" in text
+    assert "never within the chain" in text
+    assert (
+        "| SSW speed / Eq. 5 for its amplitude, simulation, elastic, N = 26 | — | 1.020 |" in text
+    )
+    assert "SSW slope ratio, simulation, elastic, N = 26 : N = 25 | > 1" in text

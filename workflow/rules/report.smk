@@ -8,6 +8,7 @@ rule summary:
         pulses=f"{TABLES}/pulses.csv",
         delays=f"{TABLES}/delays.csv",
         ssw=f"{TABLES}/ssw.csv",
+        ssw_speed=f"{TABLES}/ssw_speed.csv",
         selection=selection_files,
         runs=runs_files(),
         lib=code("summary"),

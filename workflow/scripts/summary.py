@@ -23,6 +23,7 @@ summary = build_summary(
     ssw=pd.read_csv(snakemake.input.ssw),
     selection=selection(snakemake),
     tolerance=p.tolerance if snakemake.input.get("selection") else None,
+    ssw_speed=pd.read_csv(snakemake.input.ssw_speed),
 )
 write_summary(summary, snakemake.output.json, snakemake.output.md)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])

@@ -37,7 +37,17 @@ CONTRACT_TABLES = {
     "ssw_track.csv": TRACK_COLUMNS[: TRACK_COLUMNS.index("separated") + 1],
     "ssw_speed.csv": SPEED_COLUMNS[: SPEED_COLUMNS.index("first_separated_contact") + 1],
 }
-SUMMARY_KEYS = ("run_name", "constants", "paper", "max_energy_drift", "delay_fits", "ssw_fits")
+SUMMARY_KEYS = (
+    "run_name",
+    "constants",
+    "paper",
+    "max_energy_drift",
+    "delay_fits",
+    "ssw_fits",
+    "ssw_resolved",
+    "ssw_separation",
+    "ssw_parity_ratio",
+)
 
 #: Default tolerances, by kind of number and source. Simulations are deterministic
 #: but may differ in the last bits between CPUs (FMA, libm); the virtual experiment

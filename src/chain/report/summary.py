@@ -20,6 +20,8 @@ import pandas as pd
 
 from chain.analysis.rows import flag_counts, is_ok
 from chain.analysis.selection import selection_counts
+from chain.analysis.ssw import ssw_parity_table, ssw_resolution_table
+from chain.analysis.ssw_track import separation_table
 from chain.atomic import write_text_atomic
 from chain.physics.theory import ballistic_constants
 from chain.report.paper import PAPER
@@ -82,6 +84,7 @@ def build_summary(
     ssw: pd.DataFrame | None = None,
     selection: pd.DataFrame | None = None,
     tolerance: float | None = None,
+    ssw_speed: pd.DataFrame | None = None,
 ) -> dict:
     """The contents of ``summary.json``.
 
@@ -112,6 +115,8 @@ def build_summary(
         ``experiment/selection.csv``: kept and rejected shots are counted.
     tolerance : float, optional
         The acceptance tolerance that made ``selection`` (fraction).
+    ssw_speed : DataFrame, optional
+        ``ssw_speed.csv`` (the SSW tracked along the chain).
 
     Returns
     -------
@@ -123,7 +128,8 @@ def build_summary(
         ``ssw_fits`` (the rows of the tables), ``flagged`` (per table and source:
         ``rows``, ``flagged`` = ok False, ``nan`` = ok but a NaN value; ssw counts the
         ``residual`` rows, the ones fitted and drawn), ``selection`` (kept/rejected
-        shots per series, N and kind) and ``experiment_tolerance``.
+        shots per series, N and kind), ``experiment_tolerance``, and the SSW keys of
+        :func:`ssw_summary`.
     """
     conservative = set(conservative_models)
     drift_by_model = {}
@@ -157,8 +163,45 @@ def build_summary(
             "selection": selection_counts(selection),
             "experiment_tolerance": tolerance,
             "attenuation": attenuation_rows(pulses, main_estimator),
+            **ssw_summary(ssw, ssw_fits, ssw_speed),
         }
     )
+
+
+def ssw_summary(
+    ssw: pd.DataFrame | None, ssw_fits: pd.DataFrame, ssw_speed: pd.DataFrame | None
+) -> dict:
+    """The SSW keys of ``summary.json``.
+
+    Parameters
+    ----------
+    ssw : DataFrame or None
+        ``ssw.csv``.
+    ssw_fits : DataFrame
+        ``ssw_fits.csv``.
+    ssw_speed : DataFrame or None
+        ``ssw_speed.csv``.
+
+    Returns
+    -------
+    dict
+        ``ssw_resolved``: per source, model, N and sensor, ``resolved`` (at least half
+        the shots), ``n_resolved`` of ``n_total``
+        (:func:`chain.analysis.ssw.ssw_resolution_table`); ``ssw_separation``: per
+        model, N and wave, ``first_separated_contact`` (None if never),
+        ``distance_beads`` from the collision point, ``speed_ratio`` to Eq. 5
+        (:func:`chain.analysis.ssw_track.separation_table`); ``ssw_parity_ratio``: per
+        source and model, the SSW slope of N = 26 over N = 25 (None without both).
+    """
+    separation = [] if ssw_speed is None else _records(separation_table(ssw_speed))
+    for row in separation:
+        contact = row["first_separated_contact"]
+        row["first_separated_contact"] = None if contact is None else int(contact)
+    return {
+        "ssw_resolved": [] if ssw is None else _records(ssw_resolution_table(ssw)),
+        "ssw_separation": separation,
+        "ssw_parity_ratio": _records(ssw_parity_table(ssw_fits)),
+    }
 
 
 def attenuation_rows(pulses: pd.DataFrame | None, estimator: str = "fit_full") -> list[dict]:
