@@ -343,9 +343,9 @@ def test_ssw_keys_and_rows():
     ]
     json.loads(summary_json(summary))  # NaN-free
     text = summary_markdown(summary)
+    assert "| SSW resolved at S2, simulation, elastic, N = 25 | — | no (0 of 2 shots)" in text
     assert (
-        "| SSW resolved at S2, simulation, elastic, N = 25 | yes (Fig. 2, 3 C/D) | no (0 of 2"
-        in text
+        "| SSW resolved at S2, simulation, elastic, N = 26 | yes (Fig. 2 and 3, C and D) |" in text
     )
     assert "contact 17 (4 beads from the collision point)" in text
     assert "never within the chain" in text

@@ -28,6 +28,12 @@ NOTES = [
     "large measured SSW to bead rotation and friction, neither of which is modelled.",
     "* The paper states that viscoelastic dissipation leaves Δ unchanged (Sec. V); the "
     "rows C(model) / C(conservative model) test that on this run.",
+    "* SSW: a value at a sensor needs a distinct bump behind the crossed pulse's trailing "
+    "minimum; a shoulder on its trailing edge is 'not resolved' (ssw.csv, reason). Along "
+    "the simulated chain (tables/ssw_track.csv, figures/ssw_spacetime) the SSW is a "
+    "distinct maximum from the first separated contact on; once detached from the crossed "
+    "pulse it runs at Eq. 5's speed for its own amplitude (checked in 60-bead chains by "
+    "tests/test_ssw_track.py). Contact k joins beads k and k+1.",
 ]
 
 
@@ -228,13 +234,23 @@ def _ssw_resolved_rows(summary, label) -> list[Row]:
         rows.append(
             (
                 f"SSW resolved at {row['sensor']}, {_who(row, label)}",
-                "yes (Fig. 2, 3 C/D)",
+                _paper_ssw_shown(row),
                 f"{'yes' if row['resolved'] else 'no'} ({counts})",
                 "a distinct bump behind the crossed pulse's trailing minimum, above "
                 "2 × (template misfit + 3 σ noise); yes if in at least half the shots",
             )
         )
     return rows
+
+
+def _paper_ssw_shown(row: Mapping) -> str:
+    """What the paper shows of the SSW at the sensors of this chain (Fig. 2 and 3:
+    panels C and D are the 26-bead chain)."""
+    if row["N"] == 26:
+        return "yes (Fig. 2 and 3, C and D)"
+    if row["N"] == 25 and row["source"] == "experiment":
+        return "yes (Sec. IV, odd and even N; not shown)"
+    return "—"
 
 
 def _ssw_separation_rows(summary) -> list[Row]:
@@ -259,7 +275,9 @@ def _ssw_separation_rows(summary) -> list[Row]:
                 "n/a" if ratio is None else f"{ratio:.3f}",
                 "fitted where detached from the crossed pulse, before the free end"
                 if ratio is not None
-                else "never detached over 3 contacts before the free end unloads the chain",
+                else "never separated"
+                if contact is None
+                else "not detached over 3 contacts before the free end unloads the chain",
             )
         )
     return rows
