@@ -35,7 +35,8 @@ def fig5_ssw_vs_force(
     marker per chain (circle N = 25, cross/square N = 26), a colour per model, and the
     proportional fits SSW = slope x F_m (thin lines, slope in the legend). Only SSW
     resolved at the sensor are drawn (``ok`` rows of ``ssw.csv``); a series with none
-    says so in its legend entry (with its number of shots) instead of plotting a floor.
+    says so in its legend entry (with its number of readings, shots x sensors) instead
+    of plotting a floor.
 
     Parameters
     ----------
@@ -61,7 +62,7 @@ def fig5_ssw_vs_force(
             group = rows[(rows["source"] == source) & (rows["model"] == model) & (rows["N"] == n)]
             style, label = _series_style(source, model, int(n), colors, all_n, experiment_label)
             if group.empty:
-                label += f": {NOT_RESOLVED_NOTE} (0 of {len(shots)} shots)"
+                label += f": SSW not resolved (0 of {len(shots)})"
             slope = slopes.get((source, model, int(n)))
             if not group.empty and slope is not None and np.isfinite(slope[0]):
                 label += f" (slope {slope[0]:.2e} ± {slope[1]:.1e})"
