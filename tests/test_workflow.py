@@ -22,6 +22,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from chain.analysis.ssw_track import SPEED_COLUMNS, TRACK_COLUMNS
+
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "tests" / "configs" / "tiny.yaml"
 TINY_MEASURED = ROOT / "tests" / "configs" / "tiny_measured.yaml"
@@ -58,6 +60,7 @@ FIGURES = [
     "fig4_delay_vs_force",
     "fig5_ssw_vs_force",
     "fig_parity_ssw_vs_N",
+    "ssw_spacetime",
 ]
 
 
@@ -117,6 +120,13 @@ def test_contract_files_and_columns(tiny):
         assert len(table) > 0, f"{name}.csv is empty"
         assert set(table["source"]) == {"simulation", "experiment"}
         assert set(table["model"]) == {"elastic", "viscoelastic", "virtual"}
+    # The SSW tracked along the chain: simulated collisions only.
+    track = pd.read_csv(out / "tables" / "ssw_track.csv")
+    speed = pd.read_csv(out / "tables" / "ssw_speed.csv")
+    for table, columns in ((track, TRACK_COLUMNS), (speed, SPEED_COLUMNS)):
+        assert list(table.columns[: len(columns)]) == list(columns)
+        assert set(table["source"]) == {"simulation"}
+        assert set(table["model"]) == {"elastic", "viscoelastic"}
     for name in FIGURES:
         assert (out / "figures" / f"{name}.pdf").read_bytes().startswith(b"%PDF"), name
         assert (out / "figures" / f"{name}.png").read_bytes().startswith(b"\x89PNG"), name

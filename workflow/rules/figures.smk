@@ -138,7 +138,7 @@ rule fig_parity_ssw_vs_N:
 SPACETIME_MODEL = CONSERVATIVE[0] if CONSERVATIVE else config["figures"]["traces_model"]
 
 
-rule fig_ssw_spacetime:
+rule ssw_spacetime:
     input:
         fields=[f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in TRACES_N],
         track=f"{TABLES}/ssw_track.csv",
