@@ -12,6 +12,7 @@ from chain.analysis.ssw_track import field_table, ssw_track_table
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
 from chain.report.fig_ssw_spacetime import fig_ssw_spacetime
+from chain.report.style import save_figure
 
 
 @pytest.fixture(scope="module")
@@ -42,3 +43,13 @@ def test_spacetime_panels_and_legend(tracked):
     # The 26-bead SSW is drawn where it is separated, at 4 beads and beyond.
     distances = ssw_axis.lines[1].get_xdata()
     assert len(distances) > 0 and min(distances) >= 4.0
+
+
+def test_spacetime_figure_is_byte_reproducible(tracked, tmp_path):
+    fields, track = tracked
+    paths = [
+        save_figure(fig_ssw_spacetime(fields, track, "elastic"), tmp_path / name / "ssw_spacetime")
+        for name in ("a", "b")
+    ]
+    for first, second in zip(*paths):
+        assert first.read_bytes() == second.read_bytes(), first.name
