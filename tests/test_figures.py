@@ -505,6 +505,8 @@ def test_fig3_says_when_the_ssw_is_not_resolved(trace_inputs):
     for inset in insets:
         assert any("SSW not resolved" in t.get_text() for t in inset.texts)
         assert not any(line.get_marker() == "v" for line in inset.get_lines())
+    # No SSW marker drawn: none in the legend either.
+    assert not any("SSW" in t.get_text() for t in fig.legends[0].get_texts())
 
 
 def test_fig5_series_without_resolved_points_says_so_in_the_legend():

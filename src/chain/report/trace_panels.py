@@ -90,8 +90,18 @@ def trace_figure(
                     ax.set_xlabel(
                         "time since launch (µs)" if source == "simulation" else "time (µs)"
                     )
+        # The SSW marker's legend entry only where an inset marks one.
+        marked = any(
+            line.get_marker() == "v"
+            for ax in fig.axes
+            for box in ax.child_axes
+            for line in box.get_lines()
+        )
         fig.legend(
-            handles=_legend_handles(inset), loc="outside lower center", ncol=2, frameon=False
+            handles=_legend_handles(inset and marked),
+            loc="outside lower center",
+            ncol=2,
+            frameon=False,
         )
         fig.suptitle(_suptitle(title, source, next(iter(chains.values()))["model"].iloc[0]))
     return fig
