@@ -524,3 +524,12 @@ def test_fig5_series_without_resolved_points_says_so_in_the_legend():
     ssw["ok"] = False
     fig = fig5_ssw_vs_force(ssw, fits)
     assert any("not resolved" in t.get_text() for t in fig.get_axes()[0].texts)
+
+
+def test_parity_figure_without_any_resolved_ssw_says_so():
+    fits = pd.DataFrame(
+        {"source": "simulation", "model": "elastic", "N": [25, 26], "slope": math.nan,
+         "slope_stderr": math.nan, "n_points": 0, "method": "residual"}
+    )  # fmt: skip
+    fig = fig_parity_ssw_vs_N(fits)
+    assert any("not resolved" in t.get_text() for t in fig.get_axes()[0].texts)

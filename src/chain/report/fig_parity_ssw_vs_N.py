@@ -66,5 +66,16 @@ def fig_parity_ssw_vs_N(
             "Parity: even chains (waves meet at a contact) against odd (at a bead)", loc="left"
         )
         ax.xaxis.set_major_locator(mpl.ticker.MaxNLocator(integer=True))
-        add_legend(fig, ax, own, "best")
+        if rows.empty:
+            ax.text(
+                0.5,
+                0.5,
+                "SSW not resolved at the sensors of any chain: no slope to plot",
+                transform=ax.transAxes,
+                ha="center",
+                va="center",
+                color="0.35",
+            )
+        else:
+            add_legend(fig, ax, own, "best")
     return fig
