@@ -296,15 +296,23 @@ def _ssw_claims(summary, ssw: pd.DataFrame | None) -> list[dict]:
         )
     ratios = _parity_ratios(summary)
     if ratios:
-        ok = all(ratio > 1 for _, _, ratio in ratios)
+        # A ratio is None where a chain has no SSW resolved at its sensors: untested.
+        known = [ratio for _, _, ratio in ratios if ratio is not None]
+        ok = all(ratio > 1 for ratio in known) if known else None
+        why = "" if ok else "some series give the odd chain the larger SSW"
+        if ok is None:
+            why = "not tested at the sensors: no SSW resolved there (see where it is resolved)"
         out.append(
             _claim(
                 "SSW larger in even chains",
                 "larger, no ratio",
                 "even / odd: "
-                + "; ".join(f"{series_label(summary, s, m)} {r:.2f}" for s, m, r in ratios),
+                + "; ".join(
+                    f"{series_label(summary, s, m)} " + ("n/a" if r is None else f"{r:.2f}")
+                    for s, m, r in ratios
+                ),
                 ok,
-                "" if ok else "some series give the odd chain the larger SSW",
+                why,
             )
         )
     virtual = "virtual" in summary.get("experiment_label", "")
