@@ -128,6 +128,11 @@ rule ssw_track:
     priority: 2
     conda:
         ENV
+    # Half the simulate job's work (collision shots only), same arrays per shot.
+    threads: 2
+    resources:
+        mem_mb=simulate_mem_mb,
+        runtime=simulate_runtime,
     params:
         material=config["material"],
         radius_m=config["radius_m"],
