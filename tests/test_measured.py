@@ -188,19 +188,19 @@ BAD_INPUT = [
         "time goes back",
         _csv(lambda ls: _set(ls, 6, "2.5e-06,0.04,0.08")),
         "s1.csv",
-        "line 6: time 2.5e-06 s does not increase",
+        "line 6: column t_s: time 2.5e-06 s does not increase",
     ),
     (
         "repeated time",
         _csv(lambda ls: _set(ls, 4, "1e-06,0.02,0.04")),
         "s1.csv",
-        "line 4: time 1e-06 s does not increase",
+        "line 4: column t_s: time 1e-06 s does not increase",
     ),
     (
         "uneven time",
         _csv(lambda ls: _set(ls, 5, "3.5e-06,0.03,0.06")),
         "s1.csv",
-        "line 5: time step 1.5e-06 s differs from sampling_interval_s 1e-06 s",
+        "line 5: column t_s: time step 1.5e-06 s differs from sampling_interval_s 1e-06 s",
     ),
     (
         "time in microseconds",
@@ -210,7 +210,7 @@ BAD_INPUT = [
             ]
         ),
         "s1.csv",
-        "line 3: time step 1 s differs from sampling_interval_s",
+        "line 3: column t_s: time step 1 s differs from sampling_interval_s",
     ),
     (
         "NaN value",
