@@ -210,7 +210,7 @@ BAD_INPUT = [
             ]
         ),
         "s1.csv",
-        "line 3: column t_s: time step 1 s differs from sampling_interval_s",
+        "line 3: column t_s: 7 of 7 time steps (1 s typically) differ from sampling_interval_s",
     ),
     (
         "NaN value",

@@ -51,5 +51,5 @@ def problem_list(problems: Sequence[str], limit: int = MAX_PROBLEMS) -> str:
     """
     shown = list(problems[:limit])
     if len(problems) > limit:
-        shown.append(f"... and {len(problems) - limit} more problems")
+        shown.append(f"... and more problems (the first {limit} are listed)")
     return "\n".join(shown)

@@ -74,7 +74,7 @@ def _cell_problems(where: str, rows: list[list[str]], columns: list[str], limit:
                 problems.append(
                     f"{where} line {number}: column {column}: missing or non-finite value {text!r}"
                 )
-            if len(problems) >= limit:
+            if len(problems) > limit:  # one more than listed: the caller says "and more"
                 return problems
     return problems
 
@@ -84,7 +84,7 @@ def _time_problems(where, time, body, interval, limit) -> list[str]:
     step = np.diff(time)
     problems = []
     # Step i joins data rows i and i + 1, i.e. lines i + 2 and i + 3.
-    for i in np.flatnonzero(step <= 0)[:limit]:
+    for i in np.flatnonzero(step <= 0)[: limit + 1]:
         problems.append(
             f"{where} line {i + 3}: column {TIME_COLUMN}: time {body[i + 1].split(',')[0].strip()} "
             f"s does not increase (previous sample {body[i].split(',')[0].strip()} s)"
@@ -92,7 +92,16 @@ def _time_problems(where, time, body, interval, limit) -> list[str]:
     nominal = float(np.median(step)) if interval is None else interval
     what = "sampling_interval_s" if interval is not None else "the median step"
     uneven = np.flatnonzero((step > 0) & (np.abs(step - nominal) > TIME_STEP_TOLERANCE * nominal))
-    for i in uneven[: max(limit - len(problems), 0)]:
+    if uneven.size > step.size // 2:
+        # A wrong interval or unit, not a glitch: one line says it better than hundreds.
+        typical = float(np.median(step[uneven]))
+        problems.append(
+            f"{where} line {uneven[0] + 3}: column {TIME_COLUMN}: {uneven.size} of {step.size} "
+            f"time steps ({typical:.6g} s typically) differ from {what} {nominal:.6g} s "
+            "(time not in seconds, or the wrong sampling_interval_s)"
+        )
+        return problems[:limit]
+    for i in uneven[: max(limit + 1 - len(problems), 0)]:
         problems.append(
             f"{where} line {i + 3}: column {TIME_COLUMN}: time step {step[i]:.6g} s differs from "
             f"{what} {nominal:.6g} s (uneven sampling, or time not in seconds)"
@@ -102,7 +111,8 @@ def _time_problems(where, time, body, interval, limit) -> list[str]:
 
 def _count_problems(where, rows: int, samples: int | None) -> list[str]:
     if samples is not None and rows != samples:
-        return [f"{where}: {rows} data rows, metadata samples: {samples} (truncated file?)"]
+        hint = " (truncated file?)" if rows < samples else ""
+        return [f"{where}: {rows} data rows, metadata samples: {samples}{hint}"]
     if rows < 3:
         return [f"{where}: {rows} data rows, need at least 3 (truncated file?)"]
     return []
@@ -140,7 +150,8 @@ def shot_file_problems(
     samples : int, optional
         Expected number of samples (data rows); without it, at least 3.
     limit : int
-        Stop listing after this many problems.
+        Stop listing after this many problems (plus one, so that callers know more
+        were found).
 
     Returns
     -------
@@ -172,7 +183,7 @@ def shot_file_problems(
             hint = " (truncated file?)" if number == len(rows) + 1 else ""
             problems.append(f"{where} line {number}: {len(row)} fields, expected {width}{hint}")
     if len(body) < 3 or len(problems) > len(_count_problems(where, len(body), samples)):
-        return None, problems[:limit]
+        return None, problems[: limit + 1]
     try:
         data = np.array(rows, dtype=float)
     except ValueError:
@@ -180,9 +191,9 @@ def shot_file_problems(
     if data is None or not np.all(np.isfinite(data)):
         cells = _cell_problems(where, rows, expected, limit)
         if cells or data is None:
-            return None, (problems + cells)[:limit]
+            return None, (problems + cells)[: limit + 1]
     problems += _time_problems(where, data[:, 0], body, sampling_interval_s, limit)
-    return (None if problems else data), problems[:limit]
+    return (None if problems else data), problems[: limit + 1]
 
 
 def read_shot_csv(
