@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from chain.analysis.selection import SELECTION_COLUMNS
+from chain.analysis.selection import SELECTION_COLUMNS, SKIPPED_REASON
 from chain.apparatus.dataset_check import DatasetCheck, check_dataset
 from chain.apparatus.measured import MeasuredDataError, usable_shots
 from chain.pipeline.config import ConfigError, ExperimentPart
@@ -97,7 +97,7 @@ def skipped_shot_rows(check: DatasetCheck, name: str) -> pd.DataFrame:
             "kind": check.metadata.shots[shot].kind,
             "amplitude": check.metadata.shots[shot].amplitude,
             "kept": False,
-            "reason": "skipped (experiment.bad_channels: skip): " + "; ".join(faults),
+            "reason": f"{SKIPPED_REASON}: " + "; ".join(faults),
         }
         for shot, faults in sorted(check.faults.items())
     ]
