@@ -466,3 +466,38 @@ def test_loaded_table_is_independent_of_the_folder_spelling():
     a = load_dataset(EXAMPLE)
     b = load_dataset(str(EXAMPLE) + "/")
     pd.testing.assert_frame_equal(a, b)
+
+
+# ----------------------------------------------------------------------------- schema
+
+
+def test_metadata_schema_is_the_package_file_and_linked_from_the_workflow():
+    root = Path(__file__).resolve().parents[1]
+    shipped = root / "src" / "chain" / "apparatus" / "metadata.schema.yaml"
+    linked = root / "workflow" / "schemas" / "metadata.schema.yaml"
+    assert linked.resolve() == shipped.resolve()
+    from importlib import resources
+
+    from chain.apparatus.metadata import SCHEMA_FILE, metadata_validator
+
+    assert resources.files("chain.apparatus").joinpath(SCHEMA_FILE).read_text() == (
+        shipped.read_text()
+    )
+    assert metadata_validator().schema["required"] == [
+        "N",
+        "sensor_beads",
+        "sensitivity_mV_per_N",
+        "sampling_interval_s",
+        "shots",
+    ]
+
+
+def test_readme_example_metadata_follows_the_schema():
+    """The metadata.yaml example of data/README.md is valid (the schema is the spec)."""
+    from chain.apparatus.metadata import parse_metadata
+
+    text = (Path(__file__).resolve().parents[1] / "data" / "README.md").read_text()
+    block = text.split("```yaml\nformat: hertzchain-measured-traces/1", 1)[1].split("```", 1)[0]
+    meta = parse_metadata(yaml.safe_load("format: hertzchain-measured-traces/1" + block))
+    assert meta.samples == 2600 and meta.adc_range_V == 2.0 and meta.adc_bits == 12
+    assert [s.amplitude for s in meta.shots] == [0, 0, 0, 1]
