@@ -166,3 +166,12 @@ def test_config_file_mistakes_name_file_and_line(tmp_path, text, line, fragment)
 def test_shipped_config_files_pass():
     for path in [ROOT / "config.yaml", *sorted((ROOT / "whatif").glob("*.yaml"))]:
         check_config_file(path)
+
+
+def test_command_line_names_file_and_line(tmp_path, capsys):
+    from chain.pipeline.config_files import main
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("launch:\n  v0_min_m_s: 0.1\n   count: [1\n")
+    assert main([str(ROOT / "config.yaml"), str(bad)]) == 1
+    assert f"{bad} line 3" in capsys.readouterr().err

@@ -2,8 +2,9 @@
 
 The pipeline validates its config against ``workflow/schemas/config.schema.yaml``
 first (types, ranges, defaults; snakemake.utils.validate names the key as
-``On instance['chains'][1]['N']``), then calls :func:`check_config` for the relations
-between keys (sensor beads inside their chain, the Fig. 3 model among the models, a
+``On instance['chains'][1]['N']``), then calls :func:`check_config`: every number finite
+(:func:`check_finite`, one walk over the whole config: the schema's minimum/maximum let
+NaN through), then the relations between keys (sensor beads inside their chain, the Fig. 3 model among the models, a
 duration long enough for the waves, the virtual experiment's settings...) and, when the
 experiment reads measured datasets, :func:`experiment_datasets` for their metadata.
 Every message starts with the dotted name of the offending key, e.g.

@@ -5,6 +5,10 @@ YAML", without the file or the line, and a key given twice silently keeps the la
 value. :func:`check_config_files` reads the files before Snakemake does (the main
 ``config.yaml``) or again after it (the ``--configfile`` overlays, which Snakemake
 parses before the Snakefile runs) and names both.
+
+An overlay that is not valid YAML at all stops Snakemake before the Snakefile runs, with
+Snakemake's own message (``--verbose`` shows the parser's, with file and line);
+``python -m chain.pipeline.config_files whatif/x.yaml`` names them too.
 """
 
 from __future__ import annotations
@@ -70,3 +74,23 @@ def check_config_files(paths: Iterable[str | os.PathLike]) -> None:
     by the caller)."""
     for path in paths:
         check_config_file(path)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m chain.pipeline.config_files FILE...``: name the file and line of a YAML
+    mistake in config files (Snakemake parses ``--configfile`` overlays before the
+    Snakefile runs, and its own message names neither)."""
+    import sys
+
+    status = 0
+    for path in sys.argv[1:] if argv is None else argv:
+        try:
+            check_config_file(path)
+        except ConfigError as error:
+            print(error, file=sys.stderr)
+            status = 1
+    return status
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
