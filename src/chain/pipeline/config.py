@@ -4,14 +4,15 @@ The pipeline validates its config against ``workflow/schemas/config.schema.yaml`
 first (types, ranges, defaults; snakemake.utils.validate names the key as
 ``On instance['chains'][1]['N']``), then calls :func:`check_config`: every number finite
 (:func:`check_finite`, one walk over the whole config: the schema's minimum/maximum let
-NaN through), then the relations between keys (sensor beads inside their chain, the Fig. 3 model among the models, a
-duration long enough for the waves, the virtual experiment's settings...) and, when the
-experiment reads measured datasets, :func:`experiment_datasets` for their metadata.
-Every message starts with the dotted name of the offending key, e.g.
+NaN through), then the relations between keys (sensor beads inside their chain, the
+Fig. 3 model among the models, a duration long enough for the waves, the virtual
+experiment's settings...), then :func:`experiment_parts` reads the measured datasets'
+metadata and :func:`chain.pipeline.datasets.check_experiment_datasets` checks every
+shot file of them. Every message starts with the dotted name of the offending key, e.g.
 ``config key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config
 stops before any job runs and says where.
 
-:func:`check_config` takes a plain dict and reads no file; :func:`experiment_datasets`
+:func:`check_config` takes a plain dict and reads no file; :func:`experiment_parts`
 reads the datasets' ``metadata.yaml`` (and nothing else). Neither knows Snakemake.
 
 Duration check
