@@ -13,6 +13,11 @@ from chain.pipeline.config import (
     virtual_experiment_settings,
 )
 from chain.pipeline.config import experiment_label as experiment_label_of
+from chain.pipeline.datasets import (
+    DEFAULT_CACHE as DATASET_CHECK_CACHE,
+    bad_channel_policy,
+    check_experiment_datasets,
+)
 from chain.pipeline.deps import script_sources
 from chain.pipeline.resources import simulation_needs
 from chain.physics.materials import get_material
@@ -80,6 +85,10 @@ SIMULATION_PARTS = [("simulation", model, n) for model in MODELS for n in CHAINS
 # rule all; figures and summary name the series with EXPERIMENT_LABEL ("virtual
 # experiment (model)" for the model of the apparatus, "measured (<name>)" for data).
 EXPERIMENT = {(part.name, part.n_beads): part for part in experiment_parts(config)}
+# Every shot file of every measured dataset, now: all problems on the console at once,
+# before any job (verdicts cached by file content in DATASET_CHECK_CACHE).
+check_experiment_datasets(config, list(EXPERIMENT.values()))
+BAD_CHANNELS = bad_channel_policy(config)
 EXPERIMENT_PARTS = [("experiment", name, n) for name, n in EXPERIMENT]
 SELECTION = [f"{OUT}/experiment/selection.csv"] if EXPERIMENT else []
 EXPERIMENT_LABEL = experiment_label_of(list(EXPERIMENT.values()))

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from chain.analysis.rows import flag_counts, is_ok
-from chain.analysis.selection import selection_counts
+from chain.analysis.selection import selection_counts, skipped_shots
 from chain.atomic import write_text_atomic
 from chain.physics.theory import ballistic_constants
 from chain.report.paper import PAPER
@@ -157,6 +157,8 @@ def build_summary(
             "selection": selection_counts(selection),
             "experiment_tolerance": tolerance,
             "attenuation": attenuation_rows(pulses, main_estimator),
+            # Only when shots were skipped, so that runs without any keep their bytes.
+            **({"skipped_shots": skipped} if (skipped := skipped_shots(selection)) else {}),
         }
     )
 
