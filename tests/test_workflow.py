@@ -249,10 +249,11 @@ def test_second_run_has_nothing_to_do(tiny):
 @pytest.mark.parametrize(
     ("module", "expected", "untouched"),
     [
-        # None: exactly the expected jobs, nothing else.
-        ("report/style", set(FIGURES) | {"all"}, None),
-        ("report/fig4_delay_vs_force", {"fig4_delay_vs_force", "all"}, None),
-        ("report/trace_panels", {"fig2_experiment_traces", "fig3_simulation_traces", "all"},
+        # None: exactly the expected jobs, nothing else (the article embeds every figure).
+        ("report/style", set(FIGURES) | {"article", "all"}, None),
+        ("report/fig4_delay_vs_force", {"fig4_delay_vs_force", "article", "all"}, None),
+        ("report/trace_panels", {"fig2_experiment_traces", "fig3_simulation_traces", "article",
+                                 "all"},
          None),
         ("report/summary_md", {"summary", "all"}, None),
         ("analysis/ssw", {"ssw", "ssw_fits", "fig2_experiment_traces", "fig3_simulation_traces",
