@@ -17,6 +17,12 @@ from chain.pipeline.deps import script_sources
 from chain.pipeline.resources import simulation_needs
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
+from chain.pipeline.ablation import (
+    ablation_variants,
+    overrides_text,
+    variant_settings,
+    variant_tolerance,
+)
 
 check_config(config)
 
@@ -239,3 +245,28 @@ def simulate_runtime(wildcards, threads):
 VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
 # pulses, ssw: one trace file at a time, 185 MB peak; ~2 s per trace file.
 ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
+
+
+# ---- ablation of the virtual experiment (rules in ablation.smk) -----------------
+
+ABLATION = {v["name"]: v for v in ablation_variants(config)}
+
+
+wildcard_constraints:
+    variant="|".join(ABLATION) or "no-variant",
+
+
+def ablation_settings(wildcards):
+    """Per replicate, the VirtualExperiment fields of every chain of one variant."""
+    variant = ABLATION[wildcards.variant]
+    return [
+        [
+            variant_settings(config, variant, n, c["sensors"], k)
+            for n, c in CHAINS.items()
+        ]
+        for k in range(variant["replicates"])
+    ]
+
+
+def ablation_tolerance(wildcards):
+    return variant_tolerance(config, ABLATION[wildcards.variant])

@@ -79,6 +79,9 @@ VIRTUAL_FIELDS = {
     "adc_range_V": "adc_range_V",
     "duration_s": "duration_s",
     "time_step_s": "time_step_s",
+    "readout": "readout",
+    "launch": "launch",
+    "reference_speed_mismatch": "reference_speed_mismatch",
 }
 
 
@@ -336,6 +339,10 @@ def check_config(config: Mapping) -> None:
         )
 
     _check_experiment(config)
+    # Imported here: chain.pipeline.ablation imports this module.
+    from chain.pipeline.ablation import check_ablation
+
+    check_ablation(config)
 
 
 @dataclass(frozen=True)
