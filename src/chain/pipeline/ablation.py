@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from chain.analysis.delays import delay_fit_table, delay_table
-from chain.analysis.pulses import pulse_table
+from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.rows import flag_unusable
 from chain.analysis.selection import select_shots
 from chain.errors import ParameterError
