@@ -3,12 +3,14 @@
 # chain with that variant's settings (chain.pipeline.ablation), analyses it as the
 # pipeline analyses the experiment (pulses, 5 % selection, delays) and fits
 # |Delta| = C F_m^(-1/6) and a free exponent; ablation_table gathers the variants.
-# Not in the default run (~3 min on 2 cores): `snakemake --cores 2 ablation`.
+# Variants marked default_run are in the default run (tables/ablation_exponent.csv);
+# all of them (~3-5 min on 2 cores): `snakemake --cores 2 ablation`
+# (tables/ablation_exponent_all.csv).
 
 
 rule ablation:
     input:
-        f"{TABLES}/ablation_exponent.csv",
+        f"{TABLES}/ablation_exponent_all.csv",
 
 
 rule ablation_variant:
@@ -31,20 +33,24 @@ rule ablation_variant:
         "../scripts/ablation_variant.py"
 
 
+# The default run's variants (tables/ablation_exponent.csv) and all of them
+# (tables/ablation_exponent_all.csv, target `ablation`).
 rule ablation_table:
     input:
-        fits=expand(f"{OUT}/ablation/{{variant}}_fits.csv", variant=list(ABLATION)),
+        fits=lambda wildcards: ablation_fit_files(wildcards.which),
         lib=code("ablation_table"),
     output:
-        f"{TABLES}/ablation_exponent.csv",
+        f"{TABLES}/ablation_exponent{{which}}.csv",
     log:
-        f"{LOGS}/tables/ablation_exponent.log",
+        f"{LOGS}/tables/ablation_exponent{{which}}.log",
     benchmark:
-        f"{BENCH}/tables/ablation_exponent.tsv"
+        f"{BENCH}/tables/ablation_exponent{{which}}.tsv"
+    wildcard_constraints:
+        which="|_all",
     conda:
         ENV
     params:
-        variants=list(ABLATION),
+        variants=lambda wildcards: ablation_names(wildcards.which),
         overrides={name: overrides_text(v) for name, v in ABLATION.items()},
     script:
         "../scripts/ablation_table.py"

@@ -61,13 +61,15 @@ ABLATION_COLUMNS = (
 
 
 def ablation_variants(config: Mapping) -> list[dict]:
-    """The variants of a schema-valid config: name, description, replicates, set."""
+    """The variants of a schema-valid config: name, description, replicates,
+    default_run, set."""
     variants = config.get("ablation", {}).get("variants", [])
     return [
         {
             "name": v["name"],
             "description": v.get("description", ""),
             "replicates": int(v.get("replicates", 1)),
+            "default_run": bool(v.get("default_run", False)),
             "set": dict(v.get("set") or {}),
         }
         for v in variants
