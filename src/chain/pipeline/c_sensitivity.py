@@ -45,6 +45,7 @@ C_SENSITIVITY_COLUMNS = (
     "sensors",
     "amplitudes",
     "headline",
+    "note",
 )
 
 
@@ -126,7 +127,8 @@ def c_sensitivity_table(traces: Mapping[float, Mapping[int, pd.DataFrame]], plan
     -------
     DataFrame
         Columns :data:`C_SENSITIVITY_COLUMNS`; C in us N^1/6. ``headline`` marks the rows
-        of the headline choice (repeated under each choice it belongs to).
+        of the headline choice (repeated under each choice it belongs to); ``note`` names
+        chains without a usable delay (their pooled row holds the other chains only).
     """
     chains = {int(n): tuple(pair) for n, pair in plan["chains"].items()}
     main, eta_paper = plan["main_estimator"], plan["eta_s"][1]
@@ -155,7 +157,14 @@ def c_sensitivity_table(traces: Mapping[float, Mapping[int, pd.DataFrame]], plan
 def _rows(choice, value, fits, estimator, eta, pairs, amplitudes, chains, eta_paper, main):
     headline = estimator == main and eta == eta_paper and pairs == chains and amplitudes == "all"
     sensors = "; ".join(f"N{n}: {list(pair)}" for n, pair in pairs.items())
+    # A chain without a usable delay (e.g. sensors within a pulse width of the collision,
+    # where incident and crossed pulses overlap) leaves the pooled fit to the others.
+    empty = [str(f.N) for f in fits.itertuples(index=False) if f.N != "pooled" and not f.n_points]
     for fit in fits.itertuples(index=False):
+        note = ""
+        if empty:
+            note = f"no usable delay on N = {', '.join(empty)}"
+            note += "; pooled = the other chains only" if fit.N == "pooled" else ""
         yield {
             "choice": choice,
             "value": value,
@@ -170,4 +179,5 @@ def _rows(choice, value, fits, estimator, eta, pairs, amplitudes, chains, eta_pa
             "sensors": sensors,
             "amplitudes": amplitudes,
             "headline": headline,
+            "note": note,
         }

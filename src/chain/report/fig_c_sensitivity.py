@@ -9,8 +9,13 @@ from matplotlib.figure import Figure
 
 from chain.report.style import STYLE, add_legend, axes_or_new, chain_marker
 
-#: Horizontal offset of each chain's marker within a choice, in category units.
-_OFFSETS = {"pooled": 0.0}
+#: Group titles of the choices.
+_CHOICE_NAMES = {
+    "estimator": "pulse estimator",
+    "eta_us": "η (µs)",
+    "sensors": "sensors (beads towards the collision)",
+    "amplitudes": "amplitudes",
+}
 
 
 def fig_c_sensitivity(table: pd.DataFrame, *, ax=None) -> Figure:
@@ -68,11 +73,22 @@ def fig_c_sensitivity(table: pd.DataFrame, *, ax=None) -> Figure:
             ax.text(
                 (min(members) + max(members)) / 2,
                 1.01,
-                choice,
+                _CHOICE_NAMES.get(choice, choice),
                 transform=ax.get_xaxis_transform(),
                 ha="center",
                 va="bottom",
                 fontsize=7,
+            )
+        missing = table[(table["N"].astype(str) == "pooled") & (table["note"].fillna("") != "")]
+        for row in missing.itertuples(index=False):
+            ax.annotate(
+                row.note.split(";")[0],
+                (position[(row.choice, row.value)], row.C),
+                xytext=(0, -14),
+                textcoords="offset points",
+                ha="center",
+                fontsize=5.5,
+                color="0.3",
             )
         ax.set_xlim(-0.5, len(cases) - 0.5)
         ax.set_ylabel("C (µs N$^{1/6}$), |Δ| = C F$_m^{-1/6}$")

@@ -82,9 +82,11 @@ def ablation_summary(ablation: pd.DataFrame, delay_fits: pd.DataFrame, estimator
 def c_spread_summary(table: pd.DataFrame) -> dict:
     """``{"headline_choice", "min_us_N16", "max_us_N16", "rows"}`` from
     ``c_sensitivity.csv``: the headline choice in words and the range of the pooled C
-    over every choice."""
+    over every choice whose chains all gave delays."""
     pooled = _pooled(table)
     head = pooled[pooled["headline"].astype(bool)].iloc[0]
+    # Pooled rows missing a chain are not comparable with the headline.
+    pooled = pooled[pooled["note"].fillna("") == ""]
     sim = table[table["headline"].astype(bool)]
     choice = (
         f"simulation, estimator {head['estimator']}, eta = {head['eta_us']:.3g} us, sensors "
