@@ -49,6 +49,9 @@ TABLE_COLUMNS = {
     ],
     "ssw": ["source", "model", "N", "shot", "amplitude", "sensor", "F_m_N", "ssw_N"],
     "ssw_fits": ["source", "model", "N", "slope", "slope_stderr", "n_points"],
+    "c_sensitivity": [
+        "choice", "value", "N", "C", "C_stderr", "exponent", "exponent_stderr", "headline",
+    ],
 }  # fmt: skip
 
 FIGURES = [
@@ -58,6 +61,7 @@ FIGURES = [
     "fig4_delay_vs_force",
     "fig5_ssw_vs_force",
     "fig_parity_ssw_vs_N",
+    "fig_c_sensitivity",
 ]
 
 
