@@ -84,7 +84,7 @@ def fig_c_sensitivity(table: pd.DataFrame, *, ax=None) -> Figure:
             ax.annotate(
                 row.note.split(";")[0],
                 (position[(row.choice, row.value)], row.C),
-                xytext=(0, -14),
+                xytext=(0, 9),
                 textcoords="offset points",
                 ha="center",
                 fontsize=5.5,
