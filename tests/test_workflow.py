@@ -51,6 +51,16 @@ TABLE_COLUMNS = {
     "ssw_fits": ["source", "model", "N", "slope", "slope_stderr", "n_points"],
 }  # fmt: skip
 
+#: Tables of the run as a whole (no source/model columns): C against our choices.
+RUN_TABLE_COLUMNS = {
+    "c_sensitivity": [
+        "choice", "value", "N", "C", "C_stderr", "exponent", "exponent_stderr", "headline",
+    ],
+    "ablation_exponent": [
+        "variant", "N", "C", "C_stderr", "exponent", "exponent_stderr",
+    ],
+}  # fmt: skip
+
 FIGURES = [
     "fig1_setup",
     "fig2_experiment_traces",
@@ -58,6 +68,7 @@ FIGURES = [
     "fig4_delay_vs_force",
     "fig5_ssw_vs_force",
     "fig_parity_ssw_vs_N",
+    "fig_c_sensitivity",
 ]
 
 
@@ -117,6 +128,10 @@ def test_contract_files_and_columns(tiny):
         assert len(table) > 0, f"{name}.csv is empty"
         assert set(table["source"]) == {"simulation", "experiment"}
         assert set(table["model"]) == {"elastic", "viscoelastic", "virtual"}
+    for name, columns in RUN_TABLE_COLUMNS.items():
+        table = pd.read_csv(out / "tables" / f"{name}.csv")
+        assert not [c for c in columns if c not in table.columns], name
+        assert table["headline" if name == "c_sensitivity" else "N"].notna().any(), name
     for name in FIGURES:
         assert (out / "figures" / f"{name}.pdf").read_bytes().startswith(b"%PDF"), name
         assert (out / "figures" / f"{name}.png").read_bytes().startswith(b"\x89PNG"), name

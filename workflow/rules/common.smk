@@ -13,6 +13,7 @@ from chain.pipeline.config import (
     virtual_experiment_settings,
 )
 from chain.pipeline.config import experiment_label as experiment_label_of
+from chain.pipeline.c_sensitivity import sensitivity_plan
 from chain.pipeline.datasets import (
     DEFAULT_CACHE as DATASET_CHECK_CACHE,
     bad_channel_policy,
@@ -22,6 +23,12 @@ from chain.pipeline.deps import script_sources
 from chain.pipeline.resources import simulation_needs
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
+from chain.pipeline.ablation import (
+    ablation_variants,
+    overrides_text,
+    variant_settings,
+    variant_tolerance,
+)
 
 check_config(config)
 
@@ -186,6 +193,7 @@ def figure_names():
         "fig3_simulation_traces",
         "fig4_delay_vs_force",
         "fig5_ssw_vs_force",
+        "fig_c_sensitivity",
     ]
     if EXPERIMENT_PARTS:
         names.insert(1, "fig2_experiment_traces")
@@ -197,9 +205,10 @@ def figure_names():
 
 
 def final_targets(wildcards=None):
-    tables = ["pulses", "delays", "delay_fits", "ssw", "ssw_fits"]
+    tables = ["pulses", "delays", "delay_fits", "ssw", "ssw_fits", "c_sensitivity"]
     return (
         [f"{TABLES}/{table}.csv" for table in tables]
+        + ABLATION_TABLES
         + [path for name in figure_names() for path in figure(name)]
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
         + [f"{OUT}/article.pdf"]
@@ -248,3 +257,45 @@ def simulate_runtime(wildcards, threads):
 VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
 # pulses, ssw: one trace file at a time, 185 MB peak; ~2 s per trace file.
 ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
+
+
+# ---- ablation of the virtual experiment (rules in ablation.smk) -----------------
+
+ABLATION = {v["name"]: v for v in ablation_variants(config)}
+# Variants of the default run (ablation.variants[].default_run; cheap ones) go into
+# tables/ablation_exponent.csv and the summary; `snakemake ablation` runs them all into
+# tables/ablation_exponent_all.csv. Only with the virtual experiment.
+VIRTUAL_RUN = config["experiment"]["source"] == "virtual"
+ABLATION_DEFAULT = (
+    [n for n, v in ABLATION.items() if v["default_run"]] if VIRTUAL_RUN else []
+)
+ABLATION_TABLES = [f"{TABLES}/ablation_exponent.csv"] if ABLATION_DEFAULT else []
+
+
+wildcard_constraints:
+    variant="|".join(ABLATION) or "no-variant",
+
+
+def ablation_settings(wildcards):
+    """Per replicate, the VirtualExperiment fields of every chain of one variant."""
+    variant = ABLATION[wildcards.variant]
+    return [
+        [
+            variant_settings(config, variant, n, c["sensors"], k)
+            for n, c in CHAINS.items()
+        ]
+        for k in range(variant["replicates"])
+    ]
+
+
+def ablation_tolerance(wildcards):
+    return variant_tolerance(config, ABLATION[wildcards.variant])
+
+
+def ablation_names(which):
+    """Variants of tables/ablation_exponent<which>.csv: "" the default run's, "_all" all."""
+    return list(ABLATION) if which == "_all" else ABLATION_DEFAULT
+
+
+def ablation_fit_files(which):
+    return [f"{OUT}/ablation/{name}_fits.csv" for name in ablation_names(which)]

@@ -131,3 +131,19 @@ rule fig_parity_ssw_vs_N:
         experiment_label=experiment_label,
     script:
         "../scripts/fig_parity_ssw_vs_N.py"
+
+
+rule fig_c_sensitivity:
+    input:
+        table=f"{TABLES}/c_sensitivity.csv",
+        lib=code("fig_c_sensitivity"),
+    output:
+        **figure_outputs("fig_c_sensitivity"),
+    log:
+        f"{LOGS}/figures/fig_c_sensitivity.log",
+    benchmark:
+        f"{BENCH}/figures/fig_c_sensitivity.tsv"
+    conda:
+        ENV
+    script:
+        "../scripts/fig_c_sensitivity.py"

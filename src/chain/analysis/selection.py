@@ -240,7 +240,8 @@ def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.D
     marker = table[keys].merge(dropped.assign(_drop=True), on=keys, how="left")["_drop"]
     drop = marker.fillna(False).to_numpy(dtype=bool)
     if "kind" in table.columns:
-        drop &= (table["kind"] == "collision").to_numpy()
+        # Not in place: to_numpy may return a read-only view (pandas copy-on-write).
+        drop = drop & (table["kind"] == "collision").to_numpy()
     return table.loc[~drop]
 
 

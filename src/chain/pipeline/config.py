@@ -81,6 +81,9 @@ VIRTUAL_FIELDS = {
     "adc_range_V": "adc_range_V",
     "duration_s": "duration_s",
     "time_step_s": "time_step_s",
+    "readout": "readout",
+    "launch": "launch",
+    "reference_speed_mismatch": "reference_speed_mismatch",
 }
 
 
@@ -387,6 +390,10 @@ def check_config(config: Mapping) -> None:
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
+    # Imported here: chain.pipeline.ablation imports this module.
+    from chain.pipeline.ablation import check_ablation
+
+    check_ablation(config)
 
 
 @dataclass(frozen=True)

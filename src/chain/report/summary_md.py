@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from chain.analysis.selection import SKIPPED_REASON
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
 from chain.report.paper import PAPER_ENERGY_DRIFT
+from chain.report.spread import spread_markdown_rows
 
 #: A row of the table: quantity, paper, this run, note.
 Row = tuple[str, str, str, str]
@@ -48,6 +49,7 @@ def summary_markdown(summary: Mapping) -> str:
     rows += _exponent_rows(fits, main, label)
     rows += _dissipation_rows(summary, main)
     rows += _ssw_rows(summary, label)
+    rows += spread_markdown_rows(summary)
     rows += _selection_rows(summary, label)
     rows += _skipped_rows(summary)
     rows += _flagged_rows(summary, label)
