@@ -18,7 +18,8 @@ within 10 MB (200 MB: Python, numpy, pandas, numba and the cached kernels; 48 by
 six float64 per particle and sample). The first job after a fresh clone or a kernel
 edit compiles the numba kernels instead of loading them from the cache, and that
 compilation peaks at about 590 MB before any trace is allocated (measured, N = 40):
-the base of the request is that compile peak, so a job never dies of an empty cache. The paper's N = 26, 12 speeds, 2.6 ms peaks at
+the base of the request is that compile peak, so a job never dies of an empty cache.
+Warm, the paper's N = 26, 12 speeds, 2.6 ms peaks at
 240 MB; N = 100, 24 speeds, 5.2 ms at 790 MB. A cluster job also holds the Snakemake
 process that runs the script (:data:`SNAKEMAKE_MB`, measured 200 MB), and the request
 is :data:`SAFETY` times the sum, rounded up to 100 MB.
