@@ -5,7 +5,13 @@
 
 from snakemake.utils import min_version, validate
 
+from chain.pipeline.config_files import check_config_files
+
 min_version("9.0")
+# Snakemake names neither the file nor the line of a YAML mistake, and keeps the last of
+# two equal keys: check the main config before it is read, the overlays (read already)
+# again.
+check_config_files(["config.yaml", *workflow.overwrite_configfiles])
 
 
 configfile: "config.yaml"
@@ -33,3 +39,4 @@ include: "workflow/rules/figures.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/article.smk"
 include: "workflow/rules/sweep.smk"
+include: "workflow/rules/ablation.smk"

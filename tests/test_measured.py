@@ -188,19 +188,19 @@ BAD_INPUT = [
         "time goes back",
         _csv(lambda ls: _set(ls, 6, "2.5e-06,0.04,0.08")),
         "s1.csv",
-        "line 6: time 2.5e-06 s does not increase",
+        "line 6: column t_s: time 2.5e-06 s does not increase",
     ),
     (
         "repeated time",
         _csv(lambda ls: _set(ls, 4, "1e-06,0.02,0.04")),
         "s1.csv",
-        "line 4: time 1e-06 s does not increase",
+        "line 4: column t_s: time 1e-06 s does not increase",
     ),
     (
         "uneven time",
         _csv(lambda ls: _set(ls, 5, "3.5e-06,0.03,0.06")),
         "s1.csv",
-        "line 5: time step 1.5e-06 s differs from sampling_interval_s 1e-06 s",
+        "line 5: column t_s: time step 1.5e-06 s differs from sampling_interval_s 1e-06 s",
     ),
     (
         "time in microseconds",
@@ -210,7 +210,7 @@ BAD_INPUT = [
             ]
         ),
         "s1.csv",
-        "line 3: time step 1 s differs from sampling_interval_s",
+        "line 3: column t_s: 7 of 7 time steps (1 s typically) differ from sampling_interval_s",
     ),
     (
         "NaN value",
@@ -466,3 +466,38 @@ def test_loaded_table_is_independent_of_the_folder_spelling():
     a = load_dataset(EXAMPLE)
     b = load_dataset(str(EXAMPLE) + "/")
     pd.testing.assert_frame_equal(a, b)
+
+
+# ----------------------------------------------------------------------------- schema
+
+
+def test_metadata_schema_is_the_package_file_and_linked_from_the_workflow():
+    root = Path(__file__).resolve().parents[1]
+    shipped = root / "src" / "chain" / "apparatus" / "metadata.schema.yaml"
+    linked = root / "workflow" / "schemas" / "metadata.schema.yaml"
+    assert linked.resolve() == shipped.resolve()
+    from importlib import resources
+
+    from chain.apparatus.metadata import SCHEMA_FILE, metadata_validator
+
+    assert resources.files("chain.apparatus").joinpath(SCHEMA_FILE).read_text() == (
+        shipped.read_text()
+    )
+    assert metadata_validator().schema["required"] == [
+        "N",
+        "sensor_beads",
+        "sensitivity_mV_per_N",
+        "sampling_interval_s",
+        "shots",
+    ]
+
+
+def test_readme_example_metadata_follows_the_schema():
+    """The metadata.yaml example of data/README.md is valid (the schema is the spec)."""
+    from chain.apparatus.metadata import parse_metadata
+
+    text = (Path(__file__).resolve().parents[1] / "data" / "README.md").read_text()
+    block = text.split("```yaml\nformat: hertzchain-measured-traces/1", 1)[1].split("```", 1)[0]
+    meta = parse_metadata(yaml.safe_load("format: hertzchain-measured-traces/1" + block))
+    assert meta.samples == 2600 and meta.adc_range_V == 2.0 and meta.adc_bits == 12
+    assert [s.amplitude for s in meta.shots] == [0, 0, 0, 1]

@@ -328,6 +328,17 @@ def group_alive(pgid: int) -> bool:
     return True
 
 
+def default_signal_handling() -> None:
+    """In the child, before exec: SIGINT and SIGTERM back to their default disposition.
+
+    An ignored signal stays ignored across fork and exec, and a shell starts a
+    background job (``pytest ... &``) with SIGINT ignored; Python then installs no
+    KeyboardInterrupt handler either, so Ctrl-C would not reach Snakemake or its jobs.
+    """
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, signal.SIG_DFL)
+
+
 def interrupted_run(ws: Workspace, expected: dict, args, watched: str, how: str) -> None:
     """Run Snakemake with ``args`` in its own session, interrupt it as ``how`` as soon
     as a file of results/<run>/``watched`` is being written, and wait until it and
@@ -345,6 +356,9 @@ def interrupted_run(ws: Workspace, expected: dict, args, watched: str, how: str)
             stdout=stream,
             stderr=subprocess.STDOUT,
             start_new_session=True,
+            # However pytest was started (a terminal, CI, a background job that ignores
+            # SIGINT), Snakemake must get the signals as a terminal's Ctrl-C gives them.
+            preexec_fn=default_signal_handling,
         )
     try:
         deadline = time.monotonic() + TIMEOUT

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from chain.analysis.selection import SKIPPED_REASON
 from chain.physics.theory import ballistic_constants as run_constants
 from chain.report.paper import PAPER
 from chain.report.summary import build_summary, summary_json, write_summary
@@ -276,6 +277,39 @@ def test_flag_and_selection_counts_in_summary():
     assert "C, measured (rig), all N pooled, fit_full" in text
     assert "| 45.9 ± 0.5 | measured (rig): 46.00 ± 0.20 |" in text  # beside the paper's C_exp
     assert json.loads(summary_json(data))["selection"][0]["kept"] == 1
+
+
+def test_skipped_shots_are_listed_in_the_summary():
+    """A shot skipped for a dead channel (experiment.bad_channels: skip) is a rejected
+    selection row with the channel as the reason; the summary lists it."""
+    reason = f"{SKIPPED_REASON}: data/lab/shot_0003.csv: column bead17_V: dead channel"
+    selection = pd.DataFrame(
+        {
+            "source": "experiment",
+            "model": "rig",
+            "N": 25,
+            "shot": [0, 1],
+            "kind": "collision",
+            "kept": [True, False],
+            "reason": ["kept: amplitude mismatch 1.0% <= 5%", reason],
+        }
+    )
+    data = build_summary(
+        run_name="x",
+        material="steel_100C6",
+        radius_m=0.013,
+        delay_fits=delay_fits(),
+        ssw_fits=ssw_fits(),
+        selection=selection,
+        tolerance=0.05,
+        experiment_label="measured (rig)",
+    )
+    assert data["skipped_shots"] == [{"model": "rig", "N": 25, "shot": 1, "reason": reason}]
+    text = summary_markdown(data)
+    assert (
+        "| shots skipped for a dead or saturated channel | — | 1: rig N = 25 shot 1: "
+        "data/lab/shot_0003.csv: column bead17_V: dead channel |"
+    ) in text
 
 
 def test_no_experiment_no_selection_rows(summary):

@@ -53,6 +53,16 @@ TABLE_COLUMNS = {
     "ssw_fits": ["source", "model", "N", "slope", "slope_stderr", "n_points"],
 }  # fmt: skip
 
+#: Tables of the run as a whole (no source/model columns): C against our choices.
+RUN_TABLE_COLUMNS = {
+    "c_sensitivity": [
+        "choice", "value", "N", "C", "C_stderr", "exponent", "exponent_stderr", "headline",
+    ],
+    "ablation_exponent": [
+        "variant", "N", "C", "C_stderr", "exponent", "exponent_stderr",
+    ],
+}  # fmt: skip
+
 FIGURES = [
     "fig1_setup",
     "fig2_experiment_traces",
@@ -61,6 +71,7 @@ FIGURES = [
     "fig5_ssw_vs_force",
     "fig_parity_ssw_vs_N",
     "ssw_spacetime",
+    "fig_c_sensitivity",
 ]
 
 
@@ -127,6 +138,10 @@ def test_contract_files_and_columns(tiny):
         assert list(table.columns[: len(columns)]) == list(columns)
         assert set(table["source"]) == {"simulation"}
         assert set(table["model"]) == {"elastic", "viscoelastic"}
+    for name, columns in RUN_TABLE_COLUMNS.items():
+        table = pd.read_csv(out / "tables" / f"{name}.csv")
+        assert not [c for c in columns if c not in table.columns], name
+        assert table["headline" if name == "c_sensitivity" else "N"].notna().any(), name
     for name in FIGURES:
         assert (out / "figures" / f"{name}.pdf").read_bytes().startswith(b"%PDF"), name
         assert (out / "figures" / f"{name}.png").read_bytes().startswith(b"\x89PNG"), name
@@ -259,8 +274,7 @@ def test_second_run_has_nothing_to_do(tiny):
 @pytest.mark.parametrize(
     ("module", "expected", "untouched"),
     [
-        # None: exactly the expected jobs, nothing else.
-        # The article is built from the figures and summary.json: it follows them.
+        # None: exactly the expected jobs, nothing else (the article embeds every figure).
         ("report/style", set(FIGURES) | {"article", "all"}, None),
         ("report/fig4_delay_vs_force", {"fig4_delay_vs_force", "article", "all"}, None),
         ("report/trace_panels", {"fig2_experiment_traces", "fig3_simulation_traces", "article",

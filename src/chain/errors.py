@@ -107,3 +107,27 @@ def key_label(path) -> str:
         else:
             name += f".{part}" if name else str(part)
     return name or "<top level>"
+
+
+def nonfinite_paths(value, path: tuple = ()):
+    """Yield ``(path, number)`` for every NaN or infinite float inside nested mappings
+    and lists (a parsed YAML document), ``path`` as keys and indices from the top.
+
+    JSON schema's ``minimum``/``maximum`` let NaN through (every comparison with NaN is
+    false), so a schema-valid document still needs this one general walk.
+
+    Parameters
+    ----------
+    value : mapping, list or scalar
+        The document (or part of it) to walk.
+    path : tuple
+        Path of ``value`` itself.
+    """
+    if isinstance(value, dict):
+        for key, item in value.items():
+            yield from nonfinite_paths(item, (*path, key))
+    elif isinstance(value, list | tuple):
+        for index, item in enumerate(value):
+            yield from nonfinite_paths(item, (*path, index))
+    elif isinstance(value, float | np.floating) and not math.isfinite(value):
+        yield path, float(value)

@@ -112,6 +112,29 @@ rule ssw_fits:
         "../scripts/ssw_fits.py"
 
 
+# How much C depends on our choices (issue 13, item 7): estimator, eta, sensor pair,
+# amplitude range, one at a time from the headline choice, on shots simulated anew
+# (every sensor bead of every pair recorded; chain.pipeline.c_sensitivity).
+rule c_sensitivity:
+    input:
+        code("c_sensitivity"),
+    output:
+        f"{TABLES}/c_sensitivity.csv",
+    log:
+        f"{LOGS}/tables/c_sensitivity.log",
+    benchmark:
+        f"{BENCH}/tables/c_sensitivity.tsv"
+    priority: 1
+    conda:
+        ENV
+    params:
+        plan=sensitivity_plan(config),
+        material=config["material"],
+        radius_m=config["radius_m"],
+    script:
+        "../scripts/c_sensitivity.py"
+
+
 # The SSW as a wave (issue 13): each chain's collisions re-simulated with every contact
 # recorded (the simulate rule keeps two sensor readings only), the SSW tracked contact
 # by contact; the field of the shot the space-time figure shows is kept.

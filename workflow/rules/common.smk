@@ -13,10 +13,22 @@ from chain.pipeline.config import (
     virtual_experiment_settings,
 )
 from chain.pipeline.config import experiment_label as experiment_label_of
+from chain.pipeline.c_sensitivity import sensitivity_plan
+from chain.pipeline.datasets import (
+    DEFAULT_CACHE as DATASET_CHECK_CACHE,
+    bad_channel_policy,
+    check_experiment_datasets,
+)
 from chain.pipeline.deps import script_sources
 from chain.pipeline.resources import simulation_needs
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
+from chain.pipeline.ablation import (
+    ablation_variants,
+    overrides_text,
+    variant_settings,
+    variant_tolerance,
+)
 
 check_config(config)
 
@@ -80,6 +92,10 @@ SIMULATION_PARTS = [("simulation", model, n) for model in MODELS for n in CHAINS
 # rule all; figures and summary name the series with EXPERIMENT_LABEL ("virtual
 # experiment (model)" for the model of the apparatus, "measured (<name>)" for data).
 EXPERIMENT = {(part.name, part.n_beads): part for part in experiment_parts(config)}
+# Every shot file of every measured dataset, now: all problems on the console at once,
+# before any job (verdicts cached by file content in DATASET_CHECK_CACHE).
+check_experiment_datasets(config, list(EXPERIMENT.values()))
+BAD_CHANNELS = bad_channel_policy(config)
 EXPERIMENT_PARTS = [("experiment", name, n) for name, n in EXPERIMENT]
 SELECTION = [f"{OUT}/experiment/selection.csv"] if EXPERIMENT else []
 EXPERIMENT_LABEL = experiment_label_of(list(EXPERIMENT.values()))
@@ -178,6 +194,7 @@ def figure_names():
         "fig4_delay_vs_force",
         "fig5_ssw_vs_force",
         "ssw_spacetime",
+        "fig_c_sensitivity",
     ]
     if EXPERIMENT_PARTS:
         names.insert(1, "fig2_experiment_traces")
@@ -197,9 +214,11 @@ def final_targets(wildcards=None):
         "ssw_fits",
         "ssw_track",
         "ssw_speed",
+        "c_sensitivity",
     ]
     return (
         [f"{TABLES}/{table}.csv" for table in tables]
+        + ABLATION_TABLES
         + [path for name in figure_names() for path in figure(name)]
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
         + [f"{OUT}/article.pdf"]
@@ -248,3 +267,45 @@ def simulate_runtime(wildcards, threads):
 VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
 # pulses, ssw: one trace file at a time, 185 MB peak; ~2 s per trace file.
 ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
+
+
+# ---- ablation of the virtual experiment (rules in ablation.smk) -----------------
+
+ABLATION = {v["name"]: v for v in ablation_variants(config)}
+# Variants of the default run (ablation.variants[].default_run; cheap ones) go into
+# tables/ablation_exponent.csv and the summary; `snakemake ablation` runs them all into
+# tables/ablation_exponent_all.csv. Only with the virtual experiment.
+VIRTUAL_RUN = config["experiment"]["source"] == "virtual"
+ABLATION_DEFAULT = (
+    [n for n, v in ABLATION.items() if v["default_run"]] if VIRTUAL_RUN else []
+)
+ABLATION_TABLES = [f"{TABLES}/ablation_exponent.csv"] if ABLATION_DEFAULT else []
+
+
+wildcard_constraints:
+    variant="|".join(ABLATION) or "no-variant",
+
+
+def ablation_settings(wildcards):
+    """Per replicate, the VirtualExperiment fields of every chain of one variant."""
+    variant = ABLATION[wildcards.variant]
+    return [
+        [
+            variant_settings(config, variant, n, c["sensors"], k)
+            for n, c in CHAINS.items()
+        ]
+        for k in range(variant["replicates"])
+    ]
+
+
+def ablation_tolerance(wildcards):
+    return variant_tolerance(config, ABLATION[wildcards.variant])
+
+
+def ablation_names(which):
+    """Variants of tables/ablation_exponent<which>.csv: "" the default run's, "_all" all."""
+    return list(ABLATION) if which == "_all" else ABLATION_DEFAULT
+
+
+def ablation_fit_files(which):
+    return [f"{OUT}/ablation/{name}_fits.csv" for name in ablation_names(which)]

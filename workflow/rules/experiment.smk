@@ -13,6 +13,9 @@
 # traces; selection applies the 5 % amplitude match (chain.analysis.selection.select_shots) and
 # writes experiment/selection.csv, which the delays and ssw rules use to drop rejected
 # collision shots. The parts, the label and the input functions are in common.smk.
+# Measured datasets are checked when the DAG is built (common.smk); a shot with a dead
+# or saturated channel stops the run there, or with experiment.bad_channels: skip is
+# left out of the traces and listed in selection.csv with the channel as the reason.
 
 
 rule virtual_experiment:
@@ -54,6 +57,8 @@ rule experiment_traces:
         ENV
     params:
         datasets=experiment_datasets(),
+        bad_channels=BAD_CHANNELS,
+        cache=str(DATASET_CHECK_CACHE),
     script:
         "../scripts/experiment_traces.py"
 
@@ -62,6 +67,7 @@ rule selection:
     input:
         pulses=f"{TABLES}/pulses.csv",
         traces=experiment_trace_files,
+        datasets=experiment_dataset_files(),
         lib=code("selection"),
     output:
         report(
@@ -79,5 +85,8 @@ rule selection:
     params:
         tolerance=config["experiment"]["tolerance"],
         estimator=config["analysis"]["main_estimator"],
+        datasets=experiment_datasets(),
+        bad_channels=BAD_CHANNELS,
+        cache=str(DATASET_CHECK_CACHE),
     script:
         "../scripts/selection.py"

@@ -155,3 +155,19 @@ rule ssw_spacetime:
         model=SPACETIME_MODEL,
     script:
         "../scripts/fig_ssw_spacetime.py"
+
+
+rule fig_c_sensitivity:
+    input:
+        table=f"{TABLES}/c_sensitivity.csv",
+        lib=code("fig_c_sensitivity"),
+    output:
+        **figure_outputs("fig_c_sensitivity"),
+    log:
+        f"{LOGS}/figures/fig_c_sensitivity.log",
+    benchmark:
+        f"{BENCH}/figures/fig_c_sensitivity.tsv"
+    conda:
+        ENV
+    script:
+        "../scripts/fig_c_sensitivity.py"

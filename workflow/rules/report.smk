@@ -5,6 +5,8 @@ rule summary:
     input:
         delay_fits=f"{TABLES}/delay_fits.csv",
         ssw_fits=f"{TABLES}/ssw_fits.csv",
+        c_sensitivity=f"{TABLES}/c_sensitivity.csv",
+        ablation=ABLATION_TABLES,
         pulses=f"{TABLES}/pulses.csv",
         delays=f"{TABLES}/delays.csv",
         ssw=f"{TABLES}/ssw.csv",

@@ -7,7 +7,12 @@ from chain.traces import write_traces
 
 log = start(snakemake)
 for dataset in snakemake.params.datasets:
-    table = load_dataset(dataset["folder"], name=dataset["name"])
+    table = load_dataset(
+        dataset["folder"],
+        name=dataset["name"],
+        bad_channels=snakemake.params.bad_channels,
+        cache_dir=snakemake.params.cache,
+    )
     if set(table["N"]) != {dataset["N"]}:
         raise ValueError(
             f"{dataset['folder']}: N = {sorted(set(table['N']))}, expected {dataset['N']}"

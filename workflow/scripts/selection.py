@@ -4,7 +4,9 @@ import pandas as pd
 from _logging import start
 
 from chain.analysis.selection import select_shots
+from chain.apparatus.dataset_check import check_dataset
 from chain.atomic import write_csv_atomic
+from chain.pipeline.datasets import skipped_shot_rows
 
 log = start(snakemake)
 p = snakemake.params
@@ -17,6 +19,14 @@ shots = pd.concat(
     ignore_index=True,
 )
 table = select_shots(pulses, p.tolerance, estimator=p.estimator, shots=shots)
+if p.bad_channels == "skip":
+    # Shots left out of the traces for a dead or saturated channel: rejected, with why.
+    skipped = [
+        skipped_shot_rows(check_dataset(d["folder"], cache_dir=p.cache), d["name"])
+        for d in p.datasets
+    ]
+    table = pd.concat([table, *skipped], ignore_index=True)
+    table = table.sort_values(["source", "model", "N", "shot"], kind="stable")
 for (model, n, kind), group in table.groupby(["model", "N", "kind"]):
     log.info(
         "%s N = %s %s: %d kept, %d rejected",

@@ -4,6 +4,7 @@ import pandas as pd
 from _inputs import selection
 from _logging import start
 
+from chain.report.spread import ablation_summary, c_spread_summary
 from chain.report.summary import build_summary, write_summary
 
 log = start(snakemake)
@@ -25,6 +26,15 @@ summary = build_summary(
     tolerance=p.tolerance if snakemake.input.get("selection") else None,
     ssw_speed=pd.read_csv(snakemake.input.ssw_speed),
 )
+# Issue 13 items 6 and 7: the ablation verdict (with the virtual experiment) and the
+# spread of C over our choices.
+if snakemake.input.get("ablation"):
+    summary["ablation"] = ablation_summary(
+        pd.read_csv(snakemake.input.ablation[0]),
+        pd.read_csv(snakemake.input.delay_fits),
+        p.estimator,
+    )
+summary["c_spread"] = c_spread_summary(pd.read_csv(snakemake.input.c_sensitivity))
 write_summary(summary, snakemake.output.json, snakemake.output.md)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])

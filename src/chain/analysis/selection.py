@@ -27,6 +27,10 @@ from chain.errors import ParameterError
 #: The paper's amplitude-match tolerance (5 %).
 DEFAULT_TOLERANCE = 0.05
 
+#: Start of the reason of a shot left out before the analysis for a dead or saturated
+#: channel (``experiment.bad_channels: skip``; chain.pipeline.datasets writes the rows).
+SKIPPED_REASON = "skipped (experiment.bad_channels: skip)"
+
 #: Columns of the selection table, in order.
 SELECTION_COLUMNS = (
     "source",
@@ -236,7 +240,8 @@ def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.D
     marker = table[keys].merge(dropped.assign(_drop=True), on=keys, how="left")["_drop"]
     drop = marker.fillna(False).to_numpy(dtype=bool)
     if "kind" in table.columns:
-        drop &= (table["kind"] == "collision").to_numpy()
+        # Not in place: to_numpy may return a read-only view (pandas copy-on-write).
+        drop = drop & (table["kind"] == "collision").to_numpy()
     return table.loc[~drop]
 
 
@@ -269,3 +274,27 @@ def selection_counts(selection: pd.DataFrame | None) -> list[dict]:
             }
         )
     return rows
+
+
+def skipped_shots(selection: pd.DataFrame | None) -> list[dict]:
+    """Shots left out before the analysis for a dead or saturated channel.
+
+    Parameters
+    ----------
+    selection : DataFrame or None
+        ``experiment/selection.csv``.
+
+    Returns
+    -------
+    list of dict
+        ``{"model", "N", "shot", "reason"}`` of each row whose reason starts with
+        :data:`SKIPPED_REASON`, in table order; empty when there is none.
+    """
+    if selection is None or not len(selection) or "reason" not in selection.columns:
+        return []
+    reasons = selection["reason"].astype(str)
+    rows = selection[reasons.str.startswith(SKIPPED_REASON)]
+    return [
+        {"model": str(r.model), "N": int(r.N), "shot": int(r.shot), "reason": str(r.reason)}
+        for r in rows.itertuples(index=False)
+    ]

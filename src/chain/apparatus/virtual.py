@@ -24,6 +24,11 @@ data whose truth is known:
 * acquisition (:mod:`chain.apparatus.acquisition`): additive Gaussian noise, sampling every
   ``sampling_interval_s``, volts through the sensitivity, ADC quantisation.
 
+Switches for ablation studies (:mod:`chain.pipeline.ablation`) turn single ingredients
+into the paper's simulation: ``readout="felt"`` reads plain beads instead of split
+sensor beads, ``launch="bead"`` launches the end beads instead of strikers, and
+``reference_speed_mismatch`` sets the reference shots' speed spread apart.
+
 Each nominal amplitude gets ``collision_shots`` shots with both strikers and
 ``reference_shots`` with the left striker alone (the right striker absent). The shots
 are written in the measured-trace format (:mod:`chain.apparatus.measured`), so
@@ -152,6 +157,17 @@ class VirtualExperiment:
         RK4 step, s; None: :data:`TIME_STEP_COARSENING` times the conservative default.
     seed : int
         Seed of ``numpy.random.default_rng``; the same seed gives the same bytes.
+    readout : {"sensor", "felt"}
+        ``sensor``: split sensor beads read as the sensor spring force (the apparatus);
+        ``felt``: a point readout, the sensor beads are plain beads read as
+        (F_{n-1,n} + F_{n,n+1}) / 2 (the paper's simulation, Fig. 3).
+    launch : {"striker", "bead"}
+        ``striker``: strikers of ``striker_radius`` hit beads 1 and N at the impact speed
+        (the apparatus); ``bead``: no strikers, bead 1 (and bead N) start at the impact
+        speed (the paper's simulation launch).
+    reference_speed_mismatch : float or None
+        Relative standard deviation of the reference shots' striker speed; None: the
+        same as ``speed_mismatch``. The random draws are the same whatever the value.
     """
 
     n_beads: int = 25
@@ -176,6 +192,9 @@ class VirtualExperiment:
     duration_s: float = 2.6e-3
     time_step_s: float | None = None
     seed: int = 0
+    readout: str = "sensor"
+    launch: str = "striker"
+    reference_speed_mismatch: float | None = None
 
     def __post_init__(self) -> None:
         # Checked in field order; lists from a config become tuples (the dataclass is
@@ -338,16 +357,19 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
         if settings.drop_heights_m is None
         else np.asarray(settings.drop_heights_m, dtype=float)
     )
+    check_switches(settings)
     n_amp, n_col, n_ref = speeds.size, settings.collision_shots, settings.reference_shots
     sigma = settings.speed_mismatch
+    sigma_ref = settings.reference_speed_mismatch
+    sigma_ref = sigma if sigma_ref is None else sigma_ref
     collision_draws = rng.standard_normal((n_amp, n_col, 3))
     collision_phase = rng.uniform(size=(n_amp, n_col))
     reference_draws = rng.standard_normal((n_amp, n_ref))
     reference_phase = rng.uniform(size=(n_amp, n_ref))
 
-    def speed(nominal, draw):
+    def speed(nominal, draw, spread=sigma):
         # A few-percent mismatch never makes a speed negative; the floor is a guard only.
-        return nominal * max(1.0 + sigma * draw, 0.05)
+        return nominal * max(1.0 + spread * draw, 0.05)
 
     rows = []
     for a in range(n_amp):
@@ -368,7 +390,7 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
                 (
                     "reference",
                     a,
-                    speed(speeds[a], reference_draws[a, r]),
+                    speed(speeds[a], reference_draws[a, r], sigma_ref),
                     0.0,
                     0.0,
                     reference_phase[a, r],
@@ -386,19 +408,50 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
     return plan
 
 
+#: Values of the ablation switches of :class:`VirtualExperiment`.
+READOUTS = ("sensor", "felt")
+LAUNCHES = ("striker", "bead")
+
+
+def check_switches(settings: VirtualExperiment) -> None:
+    """Check the readout and launch switches and ``reference_speed_mismatch``.
+
+    Raises
+    ------
+    ParameterError
+        Naming the field and what is allowed.
+    """
+    if settings.readout not in READOUTS:
+        raise ParameterError(f"readout must be one of {READOUTS}, got {settings.readout!r}")
+    if settings.launch not in LAUNCHES:
+        raise ParameterError(f"launch must be one of {LAUNCHES}, got {settings.launch!r}")
+    if settings.reference_speed_mismatch is not None:
+        value = require_nonnegative("reference_speed_mismatch", settings.reference_speed_mismatch)
+        if value >= 0.5:
+            raise ParameterError(f"reference_speed_mismatch is a relative std < 0.5, got {value}")
+
+
+def _launcher(model, side: int) -> slice:
+    """Particles a launch sets moving: the striker, else every particle of the end bead."""
+    striker = model.left_striker if side == 0 else model.right_striker
+    if striker >= 0:
+        return slice(striker, striker + 1)
+    bead = 0 if side == 0 else model.n_beads - 1
+    return slice(model.bead_first[bead], model.bead_last[bead] + 1)
+
+
 def _initial_displacement(model, plan: pd.DataFrame) -> np.ndarray:
-    """Striker gaps that delay one launch: u = +gap on the right striker (it starts
-    further right), u = -gap on the left one, gap = speed x |delay|."""
+    """Gaps that delay one launch: u = +gap on the right launcher (striker, or bead N
+    with ``launch="bead"``: it starts further right), u = -gap on the left one,
+    gap = speed x |delay|."""
     displacement = np.zeros((len(plan), model.n_particles))
     delay = plan["delay_s"].to_numpy()
-    late_right = delay > 0
-    displacement[late_right, model.right_striker] = (
-        plan["v_right_m_s"].to_numpy()[late_right] * delay[late_right]
-    )
-    late_left = delay < 0
-    displacement[late_left, model.left_striker] = (
-        plan["v_left_m_s"].to_numpy()[late_left] * delay[late_left]
-    )
+    late_right = np.flatnonzero(delay > 0)
+    gap = plan["v_right_m_s"].to_numpy()[late_right] * delay[late_right]
+    displacement[late_right, _launcher(model, 1)] = gap[:, None]
+    late_left = np.flatnonzero(delay < 0)
+    gap = plan["v_left_m_s"].to_numpy()[late_left] * delay[late_left]
+    displacement[late_left, _launcher(model, 0)] = gap[:, None]
     return displacement
 
 
@@ -418,7 +471,8 @@ def _sensor_forces(settings, model, plan, dt, record_interval):
             initial_displacement=_initial_displacement(model, part),
         )
         time = result.time
-        chunks.append(np.stack([result.sensor(b) for b in settings.sensor_beads], axis=1))
+        read = result.sensor if settings.readout == "sensor" else result.force_felt
+        chunks.append(np.stack([read(b) for b in settings.sensor_beads], axis=1))
     return time, np.concatenate(chunks, axis=0)
 
 
@@ -428,7 +482,9 @@ def simulate_virtual_shots(
     """Integrate the shots of ``plan`` (from :func:`plan_shots`) with the apparatus model.
 
     Collision shots use a chain with both strikers, reference shots one with the left
-    striker only, both with the same time step; each kind is batched.
+    striker only, both with the same time step; each kind is batched. With
+    ``launch="bead"`` there are no strikers (the end beads are launched) and with
+    ``readout="felt"`` no split sensor beads.
 
     Returns
     -------
@@ -437,14 +493,15 @@ def simulate_virtual_shots(
     forces : (B, n_sensors, S) N
         Sensor readings of every shot of ``plan``, in plan order.
     """
+    check_switches(settings)
     material = settings.material_object
     common = dict(
         material=material,
         radius=settings.radius,
         eta=settings.eta,
-        sensor_beads=settings.sensor_beads,
+        sensor_beads=settings.sensor_beads if settings.readout == "sensor" else (),
         sensor_stiffness=settings.sensor_stiffness,
-        striker_radius=settings.striker_radius,
+        striker_radius=settings.striker_radius if settings.launch == "striker" else None,
         drag_rate=settings.drag_rate,
     )
     both = uniform_chain(settings.n_beads, strikers="both", **common)

@@ -2,15 +2,17 @@
 
 The pipeline validates its config against ``workflow/schemas/config.schema.yaml``
 first (types, ranges, defaults; snakemake.utils.validate names the key as
-``On instance['chains'][1]['N']``), then calls :func:`check_config` for the relations
-between keys (sensor beads inside their chain, the Fig. 3 model among the models, a
-duration long enough for the waves, the virtual experiment's settings...) and, when the
-experiment reads measured datasets, :func:`experiment_datasets` for their metadata.
-Every message starts with the dotted name of the offending key, e.g.
+``On instance['chains'][1]['N']``), then calls :func:`check_config`: every number finite
+(:func:`check_finite`, one walk over the whole config: the schema's minimum/maximum let
+NaN through), then the relations between keys (sensor beads inside their chain, the
+Fig. 3 model among the models, a duration long enough for the waves, the virtual
+experiment's settings...), then :func:`experiment_parts` reads the measured datasets'
+metadata and :func:`chain.pipeline.datasets.check_experiment_datasets` checks every
+shot file of them. Every message starts with the dotted name of the offending key, e.g.
 ``config key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config
 stops before any job runs and says where.
 
-:func:`check_config` takes a plain dict and reads no file; :func:`experiment_datasets`
+:func:`check_config` takes a plain dict and reads no file; :func:`experiment_parts`
 reads the datasets' ``metadata.yaml`` (and nothing else). Neither knows Snakemake.
 
 Duration check
@@ -44,7 +46,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from chain.errors import ParameterError
+from chain.errors import ParameterError, nonfinite_paths
 from chain.errors import key_label as key_name
 from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
 from chain.physics.materials import MATERIALS, get_material
@@ -79,6 +81,9 @@ VIRTUAL_FIELDS = {
     "adc_range_V": "adc_range_V",
     "duration_s": "duration_s",
     "time_step_s": "time_step_s",
+    "readout": "readout",
+    "launch": "launch",
+    "reference_speed_mismatch": "reference_speed_mismatch",
 }
 
 
@@ -145,8 +150,7 @@ def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence
     return settings
 
 
-def _check_experiment(config: Mapping) -> None:
-    experiment = config.get("experiment", {})
+def _check_sources(experiment: Mapping) -> None:
     source = experiment.get("source", "none")
     datasets = experiment.get("datasets", [])
     if source == "measured" and not datasets:
@@ -161,10 +165,9 @@ def _check_experiment(config: Mapping) -> None:
             f"dataset folders are read only with source: measured (source is {source!r}); "
             "empty the list or set experiment.source: measured",
         )
-    if source != "virtual":
-        return
-    virtual = experiment.get("virtual", {})
-    base = ["experiment", "virtual"]
+
+
+def _check_virtual_keys(virtual: Mapping, base: list) -> None:
     if virtual.get("impact_speeds_m_s") is not None and virtual.get("drop_heights_m") is not None:
         _fail(
             [*base, "drop_heights_m"],
@@ -185,6 +188,9 @@ def _check_experiment(config: Mapping) -> None:
             f"{step:g} s is longer than sampling_interval_s = {sampling:g} s; allowed: "
             "<= the sampling interval, or null",
         )
+
+
+def _virtual_settings_of_chains(config: Mapping, base: list):
     # Imported here: chain.apparatus.virtual pulls in the simulation core.
     from chain.apparatus.virtual import VirtualExperiment
 
@@ -196,12 +202,20 @@ def _check_experiment(config: Mapping) -> None:
             )
         except ParameterError as error:
             _fail(base, f"{error} (chain N = {entry['N']})")
+    return settings
+
+
+def _check_virtual(config: Mapping) -> None:
+    virtual = config.get("experiment", {}).get("virtual", {})
+    base = ["experiment", "virtual"]
+    _check_virtual_keys(virtual, base)
+    settings = _virtual_settings_of_chains(config, base)
     speeds = settings.nominal_speeds
     beads = get_material(config["material"])
     mass_ratio = (settings.striker_radius / settings.radius) ** 3
     _check_duration(
         [*base, "duration_s"],
-        duration,
+        virtual.get("duration_s", 0.0),
         config,
         float(min(speeds)),
         mass_ratio,
@@ -220,23 +234,35 @@ def _check_experiment(config: Mapping) -> None:
         )
 
 
-def check_config(config: Mapping) -> None:
-    """Check the relations between keys of a schema-valid config.
+def _check_experiment(config: Mapping) -> None:
+    experiment = config.get("experiment", {})
+    _check_sources(experiment)
+    if experiment.get("source", "none") == "virtual":
+        _check_virtual(config)
+
+
+def check_finite(config: Mapping) -> None:
+    """Every number of a config is finite, or :class:`ConfigError` naming each key.
+
+    One walk over the whole config rather than a rule per key: the JSON schema's
+    minimum/maximum let NaN through (comparisons with NaN are false), and YAML spells
+    NaN and infinity ``.nan`` and ``.inf``.
 
     Parameters
     ----------
     config : mapping
-        The config after schema validation (defaults filled in).
-
-    Raises
-    ------
-    ConfigError
-        Naming the first offending key.
+        A config, validated or not.
     """
-    if config["material"] not in MATERIALS:
-        known = ", ".join(sorted(MATERIALS))
-        _fail(["material"], f"unknown material {config['material']!r}; known: {known}")
+    bad = [
+        f"config key {key_name(path)!r}: {number!r} is not a finite number; allowed: a "
+        "finite number in the key's range (workflow/schemas/config.schema.yaml)"
+        for path, number in nonfinite_paths(dict(config))
+    ]
+    if bad:
+        raise ConfigError("\n".join(bad))
 
+
+def _check_chains(config: Mapping) -> dict[int, int]:
     seen_n: dict[int, int] = {}
     for i, entry in enumerate(config["chains"]):
         n = entry["N"]
@@ -258,7 +284,10 @@ def check_config(config: Mapping) -> None:
                 ["chains", i, "sensors"],
                 f"got {[s1, s2]}; allowed: S1 left of S2 (S1 < S2; S1 is met first by the LSTW)",
             )
+    return seen_n
 
+
+def _check_models_and_launch(config: Mapping) -> list[str]:
     names = [m["name"] for m in config["models"]]
     for i, name in enumerate(names):
         if name in names[:i]:
@@ -266,7 +295,6 @@ def check_config(config: Mapping) -> None:
                 ["models", i, "name"],
                 f"model name {name!r} is listed twice; allowed: each name once (file names)",
             )
-
     launch = config["launch"]
     if launch["v0_min_m_s"] > launch["v0_max_m_s"]:
         _fail(
@@ -280,7 +308,10 @@ def check_config(config: Mapping) -> None:
             f"{launch['count']} launch speeds need v0_min_m_s < v0_max_m_s; allowed: count 1 "
             "when they are equal",
         )
+    return names
 
+
+def _check_simulation(config: Mapping) -> None:
     simulation = config.get("simulation", {})
     step = simulation.get("time_step_s")
     record = simulation.get("record_interval_s")
@@ -302,11 +333,13 @@ def check_config(config: Mapping) -> None:
             ["simulation", "duration_s"],
             duration,
             config,
-            launch["v0_min_m_s"],
+            config["launch"]["v0_min_m_s"],
             1.0,
             "bead 1 launched",
         )
 
+
+def _check_analysis_and_figures(config: Mapping, names: list[str], seen_n) -> None:
     analysis = config.get("analysis", {})
     if analysis.get("main_estimator") not in analysis.get("estimators", [None]):
         _fail(
@@ -314,7 +347,6 @@ def check_config(config: Mapping) -> None:
             f"{analysis.get('main_estimator')!r} is not among analysis.estimators; allowed: "
             f"{analysis.get('estimators')}",
         )
-
     figures = config.get("figures", {})
     if figures.get("traces_model") not in names:
         _fail(
@@ -328,14 +360,40 @@ def check_config(config: Mapping) -> None:
                 f"N = {n} is not a configured chain; allowed: {sorted(seen_n)}",
             )
     index = figures.get("representative_index")
-    if index is not None and index >= launch["count"]:
+    count = config["launch"]["count"]
+    if index is not None and index >= count:
         _fail(
             ["figures", "representative_index"],
-            f"{index} is not an amplitude index; allowed: 0..{launch['count'] - 1} "
-            "(launch.count speeds)",
+            f"{index} is not an amplitude index; allowed: 0..{count - 1} (launch.count speeds)",
         )
 
+
+def check_config(config: Mapping) -> None:
+    """Check a schema-valid config: every number finite, then the relations between keys.
+
+    Parameters
+    ----------
+    config : mapping
+        The config after schema validation (defaults filled in).
+
+    Raises
+    ------
+    ConfigError
+        Naming every non-finite key, else the first offending key.
+    """
+    check_finite(config)
+    if config["material"] not in MATERIALS:
+        known = ", ".join(sorted(MATERIALS))
+        _fail(["material"], f"unknown material {config['material']!r}; known: {known}")
+    seen_n = _check_chains(config)
+    names = _check_models_and_launch(config)
+    _check_simulation(config)
+    _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
+    # Imported here: chain.pipeline.ablation imports this module.
+    from chain.pipeline.ablation import check_ablation
+
+    check_ablation(config)
 
 
 @dataclass(frozen=True)

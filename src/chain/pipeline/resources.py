@@ -15,7 +15,11 @@ threads 2) for N = 16..100 beads, 4..24 launch speeds and 1.5..5.2 ms, is
     peak ~ 200 MB + (48 N + 80) bytes x B x S
 
 within 10 MB (200 MB: Python, numpy, pandas, numba and the cached kernels; 48 bytes =
-six float64 per particle and sample). The paper's N = 26, 12 speeds, 2.6 ms peaks at
+six float64 per particle and sample). The first job after a fresh clone or a kernel
+edit compiles the numba kernels instead of loading them from the cache, and that
+compilation peaks at about 590 MB before any trace is allocated (measured, N = 40):
+the base of the request is that compile peak, so a job never dies of an empty cache.
+Warm, the paper's N = 26, 12 speeds, 2.6 ms peaks at
 240 MB; N = 100, 24 speeds, 5.2 ms at 790 MB. A cluster job also holds the Snakemake
 process that runs the script (:data:`SNAKEMAKE_MB`, measured 200 MB), and the request
 is :data:`SAFETY` times the sum, rounded up to 100 MB.
@@ -41,8 +45,9 @@ from chain.errors import require_int, require_positive
 from chain.physics.model import ChainModel
 from chain.physics.simulation import default_time_step
 
-#: Resident memory of the simulate script before it allocates traces, MB (measured).
-BASE_MB = 200.0
+#: Resident memory of the simulate script before it allocates traces, MB: the numba
+#: compilation peak with an empty cache (measured 590 MB; 200 MB with a warm cache).
+BASE_MB = 600.0
 #: Bytes held per launch, recorded sample and bead (six float64, measured 47-48).
 BYTES_PER_BEAD_SAMPLE = 48.0
 #: Bytes held per launch and recorded sample besides the beads (trace table rows).

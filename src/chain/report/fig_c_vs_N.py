@@ -4,7 +4,7 @@ Drawn from ``tables/sweep.csv`` (:func:`chain.pipeline.sweep.sweep_table`), one
 colour per contact model (eta), even chains (the waves meet at a contact) filled, odd
 chains (at a bead) open, error bars one standard error; the paper's measured C
 (N = 25, 26) as a grey band for scale. Its companion, the SSW slope against N, is
-:func:`chain.report.figures.fig_parity_ssw_vs_N`.
+:func:`chain.report.fig_parity_ssw_vs_N.fig_parity_ssw_vs_N`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from chain.report.paper import PAPER
-from chain.report.style import STYLE, model_colors
+from chain.report.style import STYLE, draw_even_odd, model_colors
 
 
 def fig_c_vs_N(sweep: pd.DataFrame, *, ax=None) -> Figure:
@@ -41,24 +41,14 @@ def fig_c_vs_N(sweep: pd.DataFrame, *, ax=None) -> Figure:
             group = group.sort_values("N")
             color = colors[model]
             eta_us = group["eta_s"].iloc[0] * 1e6
-            ax.plot(group["N"], group["C_us_N16"], color=color, lw=0.6, alpha=0.5)
-            for parity, filled in (("even", True), ("odd", False)):
-                part = group[group["parity"] == parity]
-                if part.empty:
-                    continue
-                ax.errorbar(
-                    part["N"],
-                    part["C_us_N16"],
-                    yerr=part["C_stderr_us_N16"],
-                    ls="none",
-                    marker="o" if filled else "D",
-                    ms=5,
-                    color=color,
-                    mfc=color if filled else "white",
-                    mec=color,
-                    capsize=2,
-                    label=f"{model} (η = {eta_us:.2g} µs), {parity} N",
-                )
+            draw_even_odd(
+                ax,
+                group["N"],
+                group["C_us_N16"],
+                group["C_stderr_us_N16"],
+                color,
+                f"{model} (η = {eta_us:.2g} µs)",
+            )
         ax.set_xlabel("number of beads N")
         ax.set_ylabel("C (µs N$^{1/6}$), fit of |Δ| = C F$_m^{-1/6}$")
         ax.set_title("Crossing delay constant C against N (simulation)", loc="left")

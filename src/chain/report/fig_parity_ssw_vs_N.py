@@ -8,7 +8,14 @@ from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
 from chain.report import picks
-from chain.report.style import STYLE, add_legend, axes_or_new, model_colors, source_label
+from chain.report.style import (
+    STYLE,
+    add_legend,
+    axes_or_new,
+    draw_even_odd,
+    model_colors,
+    source_label,
+)
 
 
 def fig_parity_ssw_vs_N(
@@ -42,24 +49,7 @@ def fig_parity_ssw_vs_N(
             group = group.sort_values("N")
             color = colors.get(model, "black") if source == "simulation" else "black"
             name = f"{source_label(source, experiment_label)}, {model}"
-            ax.plot(group["N"], group["slope"], color=color, lw=0.6, alpha=0.5)
-            for parity, filled in (("even", True), ("odd", False)):
-                part = group[(group["N"] % 2 == 0) == (parity == "even")]
-                if part.empty:
-                    continue
-                ax.errorbar(
-                    part["N"],
-                    part["slope"],
-                    yerr=part["slope_stderr"],
-                    ls="none",
-                    marker="o" if filled else "D",
-                    ms=5,
-                    color=color,
-                    mfc=color if filled else "white",
-                    mec=color,
-                    capsize=2,
-                    label=f"{name}, {parity} N",
-                )
+            draw_even_odd(ax, group["N"], group["slope"], group["slope_stderr"], color, name)
         ax.set_xlabel("number of beads N")
         ax.set_ylabel("SSW amplitude / incident amplitude")
         ax.set_title(

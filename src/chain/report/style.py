@@ -177,3 +177,40 @@ def source_label(source: str, experiment_label: str) -> str:
 def us_n16(value: float) -> str:
     """A constant C in µs N^(1/6), for legends."""
     return f"{value:.2f} µs N$^{{1/6}}$"
+
+
+def draw_even_odd(ax, n_beads, values, stderr, color: str, label: str) -> None:
+    """A quantity against N with its error bars, even chains as filled circles and odd
+    chains as open diamonds (the parity and sweep figures), joined by a faint line.
+
+    Parameters
+    ----------
+    ax : Axes
+        Where to draw.
+    n_beads : Series of int
+        Number of beads N of each point, sorted.
+    values, stderr : Series of float
+        The quantity and its standard error, in the axis' unit.
+    color : str
+        Colour of the series.
+    label : str
+        Legend label; ", even N" / ", odd N" is appended.
+    """
+    ax.plot(n_beads, values, color=color, lw=0.6, alpha=0.5)
+    even = (n_beads.to_numpy() % 2) == 0
+    for parity, part, filled in (("even", even, True), ("odd", ~even, False)):
+        if not part.any():
+            continue
+        ax.errorbar(
+            n_beads[part],
+            values[part],
+            yerr=stderr[part],
+            ls="none",
+            marker="o" if filled else "D",
+            ms=5,
+            color=color,
+            mfc=color if filled else "white",
+            mec=color,
+            capsize=2,
+            label=f"{label}, {parity} N",
+        )

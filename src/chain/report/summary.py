@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from chain.analysis.rows import flag_counts, is_ok
-from chain.analysis.selection import selection_counts
+from chain.analysis.selection import selection_counts, skipped_shots
 from chain.analysis.ssw import ssw_parity_table, ssw_resolution_table
 from chain.analysis.ssw_track import separation_table
 from chain.atomic import write_text_atomic
@@ -164,6 +164,8 @@ def build_summary(
             "experiment_tolerance": tolerance,
             "attenuation": attenuation_rows(pulses, main_estimator),
             **ssw_summary(ssw, ssw_fits, ssw_speed),
+            # Only when shots were skipped, so that runs without any keep their bytes.
+            **({"skipped_shots": skipped} if (skipped := skipped_shots(selection)) else {}),
         }
     )
 

@@ -12,8 +12,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+from chain.analysis.selection import SKIPPED_REASON
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
 from chain.report.paper import PAPER_ENERGY_DRIFT
+from chain.report.spread import spread_markdown_rows
 
 #: A row of the table: quantity, paper, this run, note.
 Row = tuple[str, str, str, str]
@@ -56,7 +58,9 @@ def summary_markdown(summary: Mapping) -> str:
     rows += _ssw_resolved_rows(summary, label)
     rows += _ssw_separation_rows(summary)
     rows += _ssw_parity_rows(summary, label)
+    rows += spread_markdown_rows(summary)
     rows += _selection_rows(summary, label)
+    rows += _skipped_rows(summary)
     rows += _flagged_rows(summary, label)
     rows.append(_energy_row(summary))
     lines = [
@@ -418,6 +422,28 @@ def _selection_rows(summary, label) -> list[Row]:
             )
         )
     return rows
+
+
+def _skipped_rows(summary) -> list[Row]:
+    """One row listing the shots left out for a dead or saturated channel, if any."""
+    skipped = summary.get("skipped_shots") or []
+    if not skipped:
+        return []
+    shown = [
+        f"{s['model']} N = {s['N']} shot {s['shot']}: "
+        + s["reason"].removeprefix(f"{SKIPPED_REASON}: ").replace("|", "/")
+        for s in skipped[:10]
+    ]
+    more = f"; and {len(skipped) - 10} more" if len(skipped) > 10 else ""
+    return [
+        (
+            "shots skipped for a dead or saturated channel",
+            "—",
+            f"{len(skipped)}: " + "; ".join(shown) + more,
+            "experiment.bad_channels: skip; counted among the rejected shots above, every "
+            "one with its reason in experiment/selection.csv",
+        )
+    ]
 
 
 def _flagged_rows(summary, label) -> list[Row]:

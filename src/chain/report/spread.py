@@ -1,0 +1,134 @@
+"""Summary entries of the ablation of the virtual experiment and of the spread of C
+(``summary.json`` keys ``ablation`` and ``c_spread``, and their ``summary.md`` rows).
+
+The numbers come from ``tables/ablation_exponent.csv`` (chain.pipeline.ablation) and
+``tables/c_sensitivity.csv`` (chain.pipeline.c_sensitivity); nothing is computed here
+but the selection of rows and the wording.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import pandas as pd
+
+from chain.labels import VIRTUAL_LABEL
+
+#: Variants the verdict names when present: the reference shots' mismatch alone off,
+#: and every imperfection off.
+_CAUSE, _CLEAN = "no_reference_mismatch", "no_imperfections"
+
+
+def _pooled(table: pd.DataFrame) -> pd.DataFrame:
+    return table[table["N"].astype(str) == "pooled"]
+
+
+def _records(table: pd.DataFrame) -> list[dict]:
+    records = table.astype(object).where(table.notna(), None).to_dict(orient="records")
+    return [
+        {k: (v if not isinstance(v, float) or math.isfinite(v) else None) for k, v in r.items()}
+        for r in records
+    ]
+
+
+def ablation_summary(ablation: pd.DataFrame, delay_fits: pd.DataFrame, estimator: str) -> dict:
+    """``{"verdict": one sentence with the numbers, "rows": the table's rows}``.
+
+    Parameters
+    ----------
+    ablation : DataFrame
+        ``ablation_exponent.csv``.
+    delay_fits : DataFrame
+        ``delay_fits.csv`` (the run's own virtual experiment: the configured variant).
+    estimator : str
+        The main estimator.
+    """
+    run = delay_fits[
+        (delay_fits["source"] == "experiment")
+        & (delay_fits["N"].astype(str) == "pooled")
+        & (delay_fits["estimator"] == estimator)
+    ]
+    pooled = _pooled(ablation).set_index("variant")
+    if run.empty or _CAUSE not in pooled.index or _CLEAN not in pooled.index:
+        verdict = "not determined: the run lacks its virtual experiment or the variants "
+        verdict += f"{_CAUSE} and {_CLEAN}"
+        return {"verdict": verdict, "rows": _records(ablation)}
+    r, cause, clean = run.iloc[0], pooled.loc[_CAUSE], pooled.loc[_CLEAN]
+    sims = delay_fits[
+        (delay_fits["source"] == "simulation")
+        & (delay_fits["N"].astype(str) == "pooled")
+        & (delay_fits["estimator"] == estimator)
+    ]
+    simulated = ", ".join(f"{m} {p:.3f}" for m, p in zip(sims["model"], sims["exponent"]))
+    others = pooled.drop(index=[_CAUSE, _CLEAN], errors="ignore")
+    verdict = (
+        f"The {VIRTUAL_LABEL}'s steep free exponent ({r['exponent']:.3f} ± "
+        f"{r['exponent_stderr']:.3f}, chains pooled) comes from the random striker-speed "
+        "mismatch of its reference shots, whose time of flight every collision of the same "
+        f"amplitude shares: with that mismatch alone off it is {cause['exponent']:.3f} ± "
+        f"{cause['exponent_stderr']:.3f}, with every imperfection off {clean['exponent']:.3f} "
+        f"± {clean['exponent_stderr']:.3f} (simulations: {simulated})"
+    )
+    if not others.empty:
+        verdict += (
+            f"; the other variants give {others['exponent'].min():.3f} .. "
+            f"{others['exponent'].max():.3f}"
+        )
+    verdict += "; a property of the protocol's statistics, not a model artefact."
+    return {"verdict": verdict, "rows": _records(ablation)}
+
+
+def c_spread_summary(table: pd.DataFrame) -> dict:
+    """``{"headline_choice", "min_us_N16", "max_us_N16", "rows"}`` from
+    ``c_sensitivity.csv``: the headline choice in words and the range of the pooled C
+    over every choice whose chains all gave delays."""
+    pooled = _pooled(table)
+    head = pooled[pooled["headline"].astype(bool)].iloc[0]
+    # Pooled rows missing a chain are not comparable with the headline.
+    pooled = pooled[pooled["note"].fillna("") == ""]
+    sim = table[table["headline"].astype(bool)]
+    choice = (
+        f"simulation, estimator {head['estimator']}, eta = {head['eta_us']:.3g} us, sensors "
+        f"{head['sensors']}, all amplitudes, chains pooled: C = {head['C']:.2f} ± "
+        f"{head['C_stderr']:.2f} us N^1/6"
+    )
+    low, high = pooled.loc[pooled["C"].idxmin()], pooled.loc[pooled["C"].idxmax()]
+    return {
+        "headline_choice": choice,
+        "headline_C_us_N16": float(head["C"]),
+        "min_us_N16": float(low["C"]),
+        "min_choice": f"{low['choice']} = {low['value']}",
+        "max_us_N16": float(high["C"]),
+        "max_choice": f"{high['choice']} = {high['value']}",
+        "n_headline_rows": len(sim),
+        "rows": _records(table),
+    }
+
+
+def spread_markdown_rows(summary: Mapping) -> list[tuple[str, str, str, str]]:
+    """``summary.md`` rows (quantity | paper | this run | note) for both keys, if present."""
+    rows = []
+    ablation = summary.get("ablation")
+    if ablation:
+        rows.append(
+            (
+                f"why the {VIRTUAL_LABEL}'s exponent differs (ablation)",
+                "—",
+                ablation["verdict"],
+                "tables/ablation_exponent.csv; every variant: tables/ablation_exponent_all.csv",
+            )
+        )
+    spread = summary.get("c_spread")
+    if spread:
+        rows.append(
+            (
+                "C of the simulation: headline choice and spread over choices (µs N^1/6)",
+                "—",
+                f"{spread['headline_C_us_N16']:.2f}; {spread['min_us_N16']:.2f} "
+                f"({spread['min_choice']}) .. {spread['max_us_N16']:.2f} ({spread['max_choice']})",
+                f"headline: {spread['headline_choice']}; one choice changed at a time "
+                "(estimator, eta, sensor pair, amplitude half): tables/c_sensitivity.csv",
+            )
+        )
+    return rows

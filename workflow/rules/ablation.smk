@@ -1,0 +1,56 @@
+# Ablation of the virtual experiment (issue 13, item 6; a MODEL, not data): one job
+# per variant of config `ablation.variants` reruns the virtual experiment of every
+# chain with that variant's settings (chain.pipeline.ablation), analyses it as the
+# pipeline analyses the experiment (pulses, 5 % selection, delays) and fits
+# |Delta| = C F_m^(-1/6) and a free exponent; ablation_table gathers the variants.
+# Variants marked default_run are in the default run (tables/ablation_exponent.csv);
+# all of them (~3-5 min on 2 cores): `snakemake --cores 2 ablation`
+# (tables/ablation_exponent_all.csv).
+
+
+rule ablation:
+    input:
+        f"{TABLES}/ablation_exponent_all.csv",
+
+
+rule ablation_variant:
+    input:
+        code("ablation_variant"),
+    output:
+        f"{OUT}/ablation/{{variant}}_fits.csv",
+    log:
+        f"{LOGS}/ablation/{{variant}}.log",
+    benchmark:
+        f"{BENCH}/ablation/{{variant}}.tsv"
+    conda:
+        ENV
+    params:
+        settings=ablation_settings,
+        tolerance=ablation_tolerance,
+        estimators=[config["analysis"]["main_estimator"]],
+        series=VIRTUAL_NAME,
+    script:
+        "../scripts/ablation_variant.py"
+
+
+# The default run's variants (tables/ablation_exponent.csv) and all of them
+# (tables/ablation_exponent_all.csv, target `ablation`).
+rule ablation_table:
+    input:
+        fits=lambda wildcards: ablation_fit_files(wildcards.which),
+        lib=code("ablation_table"),
+    output:
+        f"{TABLES}/ablation_exponent{{which}}.csv",
+    log:
+        f"{LOGS}/tables/ablation_exponent{{which}}.log",
+    benchmark:
+        f"{BENCH}/tables/ablation_exponent{{which}}.tsv"
+    wildcard_constraints:
+        which="|_all",
+    conda:
+        ENV
+    params:
+        variants=lambda wildcards: ablation_names(wildcards.which),
+        overrides={name: overrides_text(v) for name, v in ABLATION.items()},
+    script:
+        "../scripts/ablation_table.py"

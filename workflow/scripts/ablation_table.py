@@ -1,0 +1,15 @@
+"""tables/ablation_exponent.csv from the fits of every ablation variant
+(chain.pipeline.ablation.ablation_table)."""
+
+import pandas as pd
+from _logging import start
+
+from chain.atomic import write_csv_atomic
+from chain.pipeline.ablation import ablation_table
+
+log = start(snakemake)
+p = snakemake.params
+fits = {name: pd.read_csv(path) for name, path in zip(p.variants, snakemake.input.fits)}
+table = ablation_table(fits, p.overrides)
+log.info("%d rows", len(table))
+write_csv_atomic(table, snakemake.output[0])

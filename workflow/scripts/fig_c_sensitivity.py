@@ -1,0 +1,14 @@
+"""Supplementary figure: C against our choices (chain.report.fig_c_sensitivity)."""
+
+from pathlib import Path
+
+import pandas as pd
+from _logging import start
+
+from chain.report.fig_c_sensitivity import fig_c_sensitivity
+from chain.report.style import save_figure
+
+log = start(snakemake)
+fig = fig_c_sensitivity(pd.read_csv(snakemake.input.table))
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+log.info("done")
