@@ -12,8 +12,8 @@ import pytest
 from chain.analysis.selection import SKIPPED_REASON
 from chain.physics.theory import ballistic_constants as run_constants
 from chain.report.paper import PAPER
-from chain.report.summary import build_summary, summary_json, write_summary
-from chain.report.summary_md import summary_markdown
+from chain.report.summary import build_summary, summary_json, write_summary_json
+from chain.report.summary_md import summary_markdown, write_summary_markdown
 
 #: The paper's Eq. 6 value and our recomputation agree to the printed digits.
 CBAL_PAPER_ABS_US = 0.02
@@ -190,12 +190,20 @@ def test_markdown_other_material():
     assert "n/a (no conservative model)" in text
 
 
+def write_summary(summary, json_path, md_path):
+    """The two pipeline steps: summary.json, then summary.md from it."""
+    write_summary_json(summary, json_path)
+    write_summary_markdown(json_path, md_path)
+
+
 def test_write_summary(tmp_path, summary):
     json_path, md_path = tmp_path / "out" / "summary.json", tmp_path / "out" / "summary.md"
     write_summary(summary, json_path, md_path)
     first = json_path.read_bytes(), md_path.read_bytes()
     write_summary(summary, json_path, md_path)
     assert (json_path.read_bytes(), md_path.read_bytes()) == first
+    # The Markdown read back from the JSON is the Markdown of the summary itself.
+    assert first[1].decode() == summary_markdown(json.loads(first[0]))
     assert sorted(p.name for p in json_path.parent.iterdir()) == ["summary.json", "summary.md"]
     assert json.loads(first[0])["run_name"] == "paper"
     assert np.isclose(json.loads(first[0])["max_energy_drift"], 4e-10)

@@ -280,7 +280,7 @@ def test_second_run_has_nothing_to_do(tiny):
         ("report/trace_panels", {"fig2_experiment_traces", "fig3_simulation_traces", "article",
                                  "all"},
          None),
-        ("report/summary_md", {"summary", "article", "all"}, None),
+        ("report/summary_md", {"summary_md", "all"}, None),
         ("analysis/ssw", {"ssw", "ssw_fits", "fig2_experiment_traces", "fig3_simulation_traces",
                           "fig5_ssw_vs_force", "summary"},
          {"simulate", "virtual_experiment", "experiment_traces", "pulses", "selection",

@@ -1,11 +1,11 @@
-"""summary.json and summary.md: the run's numbers beside the paper's (chain.report.summary)."""
+"""summary.json: the run's numbers beside the paper's (chain.report.summary)."""
 
 import pandas as pd
 from _inputs import selection
 from _logging import start
 
 from chain.report.spread import ablation_summary, c_spread_summary
-from chain.report.summary import build_summary, write_summary
+from chain.report.summary import build_summary, write_summary_json
 
 log = start(snakemake)
 p = snakemake.params
@@ -35,7 +35,7 @@ if snakemake.input.get("ablation"):
         p.estimator,
     )
 summary["c_spread"] = c_spread_summary(pd.read_csv(snakemake.input.c_sensitivity))
-write_summary(summary, snakemake.output.json, snakemake.output.md)
+write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])
 log.info("selection: %s", summary["selection"])

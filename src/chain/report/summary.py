@@ -3,8 +3,8 @@
 Every number is computed from the run's tables and the closed forms of
 :mod:`chain.physics.theory`, except the paper's own values in :data:`PAPER`, quoted as
 printed. :func:`build_summary` gathers them into a JSON-ready dict, :func:`summary_json`
-writes it with sorted keys and fixed float formatting, and :func:`write_summary` writes
-``summary.json`` and the Markdown table of :mod:`chain.report.summary_md` atomically.
+writes it with sorted keys and fixed float formatting, and :func:`write_summary_json`
+writes ``summary.json`` atomically; :mod:`chain.report.summary_md` writes the Markdown from it.
 """
 
 from __future__ import annotations
@@ -25,7 +25,6 @@ from chain.analysis.ssw_track import separation_table
 from chain.atomic import write_text_atomic
 from chain.physics.theory import ballistic_constants
 from chain.report.paper import PAPER
-from chain.report.summary_md import summary_markdown
 
 #: Significant digits of floats in summary.json.
 JSON_DIGITS = 10
@@ -262,17 +261,16 @@ def _residual_rows(ssw: pd.DataFrame | None) -> pd.DataFrame | None:
     return ssw[ssw["method"] == "residual"]
 
 
-def write_summary(
-    summary: Mapping, json_path: str | os.PathLike, markdown_path: str | os.PathLike
-) -> None:
-    """Write ``summary.json`` and ``summary.md`` atomically (temporary name, then rename).
+def write_summary_json(summary: Mapping, json_path: str | os.PathLike) -> None:
+    """Write ``summary.json`` atomically (temporary name, then rename), sorted keys and
+    floats to :data:`JSON_DIGITS` digits; ``summary.md`` is written from it by
+    :func:`chain.report.summary_md.write_summary_markdown`.
 
     Parameters
     ----------
     summary : mapping
         The dict of :func:`build_summary`.
-    json_path, markdown_path : path
-        Destinations.
+    json_path : path
+        Destination.
     """
     write_text_atomic(summary_json(summary), json_path)
-    write_text_atomic(summary_markdown(summary), markdown_path)

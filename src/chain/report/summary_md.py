@@ -9,10 +9,14 @@ rewrites ``summary.md`` and reruns nothing else.
 
 from __future__ import annotations
 
+import json
 import math
+import os
 from collections.abc import Mapping
+from pathlib import Path
 
 from chain.analysis.selection import SKIPPED_REASON
+from chain.atomic import write_text_atomic
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
 from chain.report.paper import PAPER_ENERGY_DRIFT
 from chain.report.spread import spread_markdown_rows
@@ -450,7 +454,9 @@ def _flagged_rows(summary, label) -> list[Row]:
     """How many table rows were flagged (ok False) or NaN, and so left out."""
     flagged = summary.get("flagged") or {}
     parts = []
-    for table, by_source in flagged.items():
+    # In pipeline order, whatever order the JSON kept its keys in.
+    order = {"pulses": 0, "delays": 1, "ssw": 2}
+    for table, by_source in sorted(flagged.items(), key=lambda item: order.get(item[0], 9)):
         counts = []
         for source, c in sorted(by_source.items(), key=lambda item: item[0] != "simulation"):
             who = label if source == "experiment" else source
@@ -490,3 +496,18 @@ def _experiment_c(summary, main, label="experiment") -> str:
         f"{_pm(r.get('C_us_N16'), r.get('C_stderr_us_N16'), 1)}"
         for r in rows
     )
+
+
+def write_summary_markdown(json_path: str | os.PathLike, markdown_path: str | os.PathLike) -> None:
+    """Write ``summary.md`` (:func:`summary_markdown`) from a written ``summary.json``,
+    atomically. Its own step, so that rewording the Markdown reruns nothing else.
+
+    Parameters
+    ----------
+    json_path : path
+        ``summary.json`` (:func:`chain.report.summary.write_summary_json`).
+    markdown_path : path
+        Destination.
+    """
+    summary = json.loads(Path(json_path).read_text())
+    write_text_atomic(summary_markdown(summary), markdown_path)
