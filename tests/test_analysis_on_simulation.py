@@ -14,7 +14,7 @@ import pytest
 
 import chain
 from chain.analysis.delays import delay_fit_table, delay_table
-from chain.analysis.pulses import pulse_table
+from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.ssw import NOT_RESOLVED, ssw_fit_table, ssw_table
 from chain.physics.theory import ballistic_delay_constant_exact
 

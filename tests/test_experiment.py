@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from chain.analysis.delays import delay_fit_table, delay_table
-from chain.analysis.pulses import pulse_table
+from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.selection import select_shots
 from chain.apparatus.acquisition import adc_step, volts_to_newtons
 from chain.apparatus.measured import METADATA_FILE, load_dataset

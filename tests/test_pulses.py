@@ -216,13 +216,9 @@ def test_pulse_table_roles_and_flagged_rows():
     assert not fits.loc[(2, "S2", "crossed"), "ok"]
 
 
-def test_pulse_table_importable_from_its_old_home():
-    """The table moved to chain.analysis.pulse_rows; chain.pulse_table and
-    chain.analysis.pulses.pulse_table still name the same function."""
+def test_pulse_table_is_the_public_one():
+    """chain.pulse_table and chain.analysis.pulse_table name the pulses-table function."""
     import chain
-    import chain.analysis.pulses as pulses
+    import chain.analysis
 
-    assert pulses.pulse_table is pulse_table is chain.pulse_table
-    assert pulses.PULSE_COLUMNS is PULSE_COLUMNS
-    with pytest.raises(AttributeError):
-        pulses.no_such_name  # noqa: B018
+    assert chain.pulse_table is pulse_table is chain.analysis.pulse_table

@@ -71,7 +71,8 @@ import pytest
 
 from chain import default_time_step, simulate, simulate_shots, uniform_chain
 from chain.analysis.delays import delay_fit_table, delay_table
-from chain.analysis.pulses import find_pulses, pulse_table
+from chain.analysis.pulse_rows import pulse_table
+from chain.analysis.pulses import find_pulses
 from chain.analysis.ssw import ssw_fit_table, ssw_table
 from chain.errors import ParameterError
 from chain.physics.integrator import IntegrationError

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.analysis.pulses import pulse_table
+from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.ssw import (
     NOT_RESOLVED,
     SSW_COLUMNS,

@@ -451,13 +451,3 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
         float(tau_error),
         n_samples=length,
     )
-
-
-def __getattr__(name: str):
-    # The pulses table moved to chain.analysis.pulse_rows; its names stay importable
-    # from here (chain.pulse_table, older scripts and tests), loaded on first use.
-    if name in ("pulse_table", "PULSE_COLUMNS"):
-        from chain.analysis import pulse_rows
-
-        return getattr(pulse_rows, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

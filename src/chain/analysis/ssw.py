@@ -278,7 +278,7 @@ def ssw_table(
     traces : DataFrame
         The trace table the pulses came from (:mod:`chain.traces`).
     pulses : DataFrame
-        ``pulses.csv`` rows of these traces (:func:`chain.analysis.pulses.pulse_table`).
+        ``pulses.csv`` rows of these traces (:func:`chain.analysis.pulse_rows.pulse_table`).
     selection : DataFrame, optional
         Shot selection (``shot``, ``kept``); collision shots with ``kept`` False are
         dropped. None keeps every shot.
