@@ -19,6 +19,7 @@ from chain.physics.simulation import (
     DEFAULT_RECORD_INTERVAL,
     SimulationResult,
     default_time_step,
+    felt_contacts,
     simulate,
 )
 from chain.traces import META_COLUMNS, sensor_column
@@ -161,6 +162,9 @@ def simulate_shots(
             dt=dt,
             record_interval=record_interval,
             max_energy_drift=max_energy_drift,
+            # Record only what the readout reads (sensor springs are always kept).
+            contacts=felt_contacts(model, sensor_beads) if readout == "felt" else (),
+            beads=(),
         )
         first = offset * len(speeds)
         tables.append(

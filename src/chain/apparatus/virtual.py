@@ -83,7 +83,7 @@ from chain.physics.model import (
     PCB_200B02_STIFFNESS,
     uniform_chain,
 )
-from chain.physics.simulation import default_time_step, simulate
+from chain.physics.simulation import default_time_step, felt_contacts, simulate
 
 #: File beside the shots recording the true launch of each shot (ignored by the loader).
 TRUTH_FILE = "virtual_truth.csv"
@@ -469,6 +469,11 @@ def _sensor_forces(settings, model, plan, dt, record_interval):
             dt=dt,
             record_interval=record_interval,
             initial_displacement=_initial_displacement(model, part),
+            # Record only what the readout reads (sensor springs are always kept).
+            contacts=(
+                felt_contacts(model, settings.sensor_beads) if settings.readout == "felt" else ()
+            ),
+            beads=(),
         )
         time = result.time
         read = result.sensor if settings.readout == "sensor" else result.force_felt

@@ -84,6 +84,24 @@ def _moving_masses(model: ChainModel) -> np.ndarray:
     return moving
 
 
+def felt_contacts(model: ChainModel, beads) -> tuple[int, ...]:
+    """The contacts whose forces :meth:`SimulationResult.force_felt` reads for ``beads``:
+    k = n-1 and n for bead n (an end bead's outer side is the end force, always kept).
+
+    Pass them as ``simulate(..., contacts=...)`` to record only what a readout needs.
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain.
+    beads : sequence of int
+        Bead numbers n, 1..N.
+    """
+    n_beads = model.n_beads
+    wanted = {k for n in beads for k in (int(n) - 1, int(n)) if 1 <= k <= n_beads - 1}
+    return tuple(sorted(wanted))
+
+
 @dataclass(frozen=True)
 class SimulationResult:
     """A batch of simulated launches of one chain, indexed the way a person reads it.
