@@ -153,6 +153,7 @@ rule ssw_spacetime:
         ENV
     params:
         model=SPACETIME_MODEL,
+        chains=TRACES_N,
     script:
         "../scripts/fig_ssw_spacetime.py"
 
