@@ -154,13 +154,17 @@ def bead_velocity_from_force(
     """
     radius = require_positive("radius", radius)
     force = np.asarray(peak_force, dtype=float)
-    velocity = (
+    velocity = _velocity_scale(material, radius) * force ** (5.0 / 6.0)
+    return float(velocity) if np.ndim(velocity) == 0 else velocity
+
+
+def _velocity_scale(material: Material, radius: float) -> float:
+    # V_m = scale * F_m^(5/6): the prefactor of the V_m <-> F_m relation, one home.
+    return (
         (6.0 / (5.0 * math.pi * material.density)) ** 0.5
         * material.theta ** (1.0 / 3.0)
         * radius ** (-5.0 / 3.0)
-        * force ** (5.0 / 6.0)
     )
-    return float(velocity) if np.ndim(velocity) == 0 else velocity
 
 
 def force_from_bead_velocity(
@@ -179,12 +183,7 @@ def force_from_bead_velocity(
     """
     radius = require_positive("radius", radius)
     velocity = np.asarray(peak_bead_velocity, dtype=float)
-    scale = (
-        (6.0 / (5.0 * math.pi * material.density)) ** 0.5
-        * material.theta ** (1.0 / 3.0)
-        * radius ** (-5.0 / 3.0)
-    )
-    force = (velocity / scale) ** 1.2
+    force = (velocity / _velocity_scale(material, radius)) ** 1.2
     return float(force) if np.ndim(force) == 0 else force
 
 
