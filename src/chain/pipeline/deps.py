@@ -21,6 +21,14 @@ PACKAGE = "chain"
 def _imported_names(path: Path) -> list[tuple[str, list[str]]]:
     """(module, names) of each import statement of ``path``, anywhere in the file;
     relative imports are made absolute for files inside the package."""
+    status = path.stat()
+    return _parsed_imports(path, status.st_mtime_ns, status.st_size)
+
+
+@cache
+def _parsed_imports(path: Path, mtime_ns: int, size: int) -> list[tuple[str, list[str]]]:
+    """:func:`_imported_names` of one version of a file. Every rule asks for the same
+    few dozen modules: parsed once per version (the key), not once per rule."""
     tree = ast.parse(path.read_text(), filename=str(path))
     found = []
     for node in ast.walk(tree):
