@@ -116,3 +116,22 @@ def test_bad_input_exits_2_naming_the_parameter(arguments, fragment, tmp_path, m
     error = capsys.readouterr().err
     assert "error" in error and fragment in error
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_check_config_names_file_and_line_of_an_overlay_that_is_not_yaml(tmp_path, capsys):
+    # The case Snakemake reports as "Config file is not valid JSON or YAML" only.
+    good = tmp_path / "good.yaml"
+    good.write_text("run_name: ok\nlaunch:\n  count: 4\n")
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("run_name: x\nlaunch:\n  count: 4\n\tv0_min_m_s: 0.1\n")
+    repeated = tmp_path / "repeated.yaml"
+    repeated.write_text("run_name: a\nrun_name: b\n")
+
+    assert main(["check-config", str(good)]) == 0
+    assert "good.yaml: valid YAML" in capsys.readouterr().out
+    assert main(["check-config", str(good), str(broken), str(repeated)]) == 1
+    errors = capsys.readouterr().err.splitlines()
+    assert len(errors) == 2
+    assert errors[0].startswith(f"{broken} line 4, column 1: not valid YAML")
+    assert errors[1].startswith(f"{repeated} line 2")
+    assert "run_name" in errors[1]

@@ -45,7 +45,7 @@ def _build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="command")
-    for add_command in (_add_simulate, _add_analyse, _add_theory, _add_check):
+    for add_command in (_add_simulate, _add_analyse, _add_theory, _add_check, _add_check_config):
         add_command(commands)
     return parser
 
@@ -177,6 +177,25 @@ def _add_check(commands) -> None:
     )
 
 
+def _add_check_config(commands) -> None:
+    check = commands.add_parser(
+        "check-config",
+        help="name the file and line of a YAML mistake in config files",
+        description="Parse config files (config.yaml, what-if overlays) as the pipeline "
+        "does and name the file, line and column of a YAML mistake or a repeated key. "
+        "Snakemake reads --configfile overlays before the workflow's own checks run, and "
+        "its message for an overlay that is not YAML names neither file nor line. "
+        "Exit status 1 if any file has a problem.",
+    )
+    check.add_argument("configfiles", nargs="+", help="YAML config files")
+
+
+def _check_config(args: argparse.Namespace) -> int:
+    from chain.pipeline.config_files import main as check_config_files
+
+    return check_config_files(args.configfiles)
+
+
 def _check(args: argparse.Namespace) -> int:
     from pathlib import Path
 
@@ -278,7 +297,13 @@ def _theory(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``hertzchain`` console script; returns the exit status."""
     args = _build_parser().parse_args(argv)
-    handlers = {"simulate": _simulate, "analyse": _analyse, "theory": _theory, "check": _check}
+    handlers = {
+        "simulate": _simulate,
+        "analyse": _analyse,
+        "theory": _theory,
+        "check": _check,
+        "check-config": _check_config,
+    }
     try:
         return handlers[args.command](args)
     except (ParameterError, TraceFormatError, IntegrationError, FileNotFoundError) as error:

@@ -89,6 +89,8 @@ def main(argv: list[str] | None = None) -> int:
         except ConfigError as error:
             print(error, file=sys.stderr)
             status = 1
+        else:
+            print(f"{path}: valid YAML, no repeated keys")
     return status
 
 
