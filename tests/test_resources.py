@@ -15,9 +15,11 @@ from chain.physics.model import uniform_chain
 from chain.pipeline.resources import (
     BASE_MB,
     BYTES_PER_BEAD_SAMPLE,
+    MAX_THREADS,
     MIN_RUNTIME_MIN,
     SNAKEMAKE_MB,
     simulation_needs,
+    simulation_threads,
 )
 
 STEEL = get_material("steel_100C6")
@@ -89,3 +91,17 @@ def test_request_covers_the_measured_peak(tmp_path):
     peak_mb = float(out.stdout.split()[-1])
     request = needs(40, launches=8, duration=3.0e-3).mem_mb
     assert peak_mb < request - SNAKEMAKE_MB, (peak_mb, request)
+
+
+def test_threads_follow_the_integration_work():
+    """Small jobs take one core (two of them then run at once); long sweeps take more,
+    never more than their launches or MAX_THREADS."""
+
+    def threads(n_beads, launches, duration):
+        chain = uniform_chain(n_beads, STEEL, RADIUS, 0.58e-6)
+        return simulation_threads(chain, launches, 1.0, duration)
+
+    assert threads(26, 12, 2.6e-3) == 1  # the paper's jobs
+    assert threads(100, 24, 5.2e-3) > 1
+    assert threads(100, 24, 5.2e-3) <= threads(400, 24, 5.2e-3) <= MAX_THREADS
+    assert threads(5000, 3, 50e-3) == 3  # one launch per thread at most

@@ -151,8 +151,9 @@ rule ssw_track:
     priority: 2
     conda:
         ENV
-    # Half the simulate job's work (collision shots only), same arrays per shot.
-    threads: 2
+    # Half the simulate job's work (collision shots only), same arrays per shot: the
+    # simulate job's threads and resources are an upper bound.
+    threads: simulate_threads
     resources:
         mem_mb=simulate_mem_mb,
         runtime=simulate_runtime,

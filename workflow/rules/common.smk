@@ -20,7 +20,7 @@ from chain.pipeline.datasets import (
     check_experiment_datasets,
 )
 from chain.pipeline.deps import script_sources
-from chain.pipeline.resources import simulation_needs
+from chain.pipeline.resources import simulation_needs, simulation_threads
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
 from chain.pipeline.ablation import (
@@ -233,24 +233,43 @@ def final_targets(wildcards=None):
 # rest is measured on the paper run (peak RSS of the script, results/paper/benchmarks,
 # plus the job's own Snakemake process, 200 MB, times 1.5) and rounded up.
 # Rules not listed take the profile's default-resources.
-def simulate_needs(wildcards, threads):
+def simulated_chain(wildcards):
+    """The ChainModel a simulate (or ssw_track) job integrates."""
     n = int(wildcards.N)
-    sim = config["simulation"]
-    model = uniform_chain(
+    return uniform_chain(
         n,
         get_material(config["material"]),
         config["radius_m"],
         MODELS[wildcards.model]["eta_s"],
-        sensor_beads=CHAINS[n]["sensors"] if sim["readout"] == "sensor" else (),
+        sensor_beads=(
+            CHAINS[n]["sensors"] if config["simulation"]["readout"] == "sensor" else ()
+        ),
     )
+
+
+def simulate_needs(wildcards, threads):
+    sim = config["simulation"]
     return simulation_needs(
-        model,
+        simulated_chain(wildcards),
         len(SPEEDS),
         max(SPEEDS),
         sim["duration_s"],
         sim["record_interval_s"],
         sim["time_step_s"],
         threads,
+    )
+
+
+# Threads: one per ~10 s of estimated integration (chain.pipeline.resources): the
+# paper's jobs take 1, so two of them run at once on 2 cores; a long sweep job more.
+def simulate_threads(wildcards):
+    sim = config["simulation"]
+    return simulation_threads(
+        simulated_chain(wildcards),
+        len(SPEEDS),
+        max(SPEEDS),
+        sim["duration_s"],
+        sim["time_step_s"],
     )
 
 

@@ -30,7 +30,9 @@ rule virtual_experiment:
     priority: 3
     conda:
         ENV
-    threads: 2
+    # ~1.3 s of integration per chain (40 launches): a second core would shorten it by
+    # less than the job another core runs meanwhile.
+    threads: 1
     resources:
         mem_mb=VIRTUAL_EXPERIMENT_JOB["mem_mb"],
         runtime=VIRTUAL_EXPERIMENT_JOB["runtime"],

@@ -15,7 +15,7 @@ rule simulate:
     priority: 2
     conda:
         ENV
-    threads: 2
+    threads: simulate_threads
     resources:
         mem_mb=simulate_mem_mb,
         runtime=simulate_runtime,

@@ -62,6 +62,13 @@ SECONDS_PER_PARTICLE_STEP = 1e-7
 STARTUP_S = 60.0
 #: Shortest run time asked for, minutes.
 MIN_RUNTIME_MIN = 10
+#: Estimated single-core integration a job needs before a second core pays, s. A
+#: thread parallelises only the integration; the job's 1-2 s of start-up and writing
+#: are serial, and a core held idle by a small job is a core another job cannot use
+#: (the paper run's jobs, ~2 s of estimate each, ran one at a time with 2 threads).
+SECONDS_PER_THREAD = 10.0
+#: Most threads a job asks for (Snakemake gives no more than --cores anyway).
+MAX_THREADS = 8
 
 
 @dataclass(frozen=True)
@@ -70,6 +77,45 @@ class JobNeeds:
 
     mem_mb: int
     runtime: int
+
+
+def _integration_seconds(
+    model: ChainModel, n_launches: int, max_launch_speed: float, duration: float, dt
+) -> float:
+    """Estimated single-core RK4 time of 2 ``n_launches`` launches, s (the bound
+    :data:`SECONDS_PER_PARTICLE_STEP`)."""
+    if dt is None:
+        dt = default_time_step(model, require_positive("max_launch_speed", max_launch_speed))
+    return 2 * n_launches * model.n_particles * (duration / dt) * SECONDS_PER_PARTICLE_STEP
+
+
+def simulation_threads(
+    model: ChainModel,
+    n_launches: int,
+    max_launch_speed: float,
+    duration: float,
+    dt: float | None = None,
+) -> int:
+    """Cores worth giving a simulate job: one per :data:`SECONDS_PER_THREAD` of
+    estimated integration, at least 1, at most the launches and :data:`MAX_THREADS`.
+
+    The result does not depend on the thread count: launches are independent and
+    each runs on one thread (bit-identical to a serial run).
+
+    Parameters
+    ----------
+    model, n_launches, max_launch_speed, duration, dt
+        As in :func:`simulation_needs` (m/s, s).
+
+    Returns
+    -------
+    int
+        Threads (the paper's chains: 1; N = 100, 24 speeds, 5.2 ms: 4).
+    """
+    n_launches = require_int("n_launches", n_launches, 1)
+    duration = require_positive("duration", duration)
+    work = _integration_seconds(model, n_launches, max_launch_speed, duration, dt)
+    return max(1, min(n_launches, MAX_THREADS, math.ceil(work / SECONDS_PER_THREAD)))
 
 
 def simulation_needs(
@@ -109,12 +155,10 @@ def simulation_needs(
     threads = require_int("threads", threads, 1)
     duration = require_positive("duration", duration)
     record_interval = require_positive("record_interval", record_interval)
-    if dt is None:
-        dt = default_time_step(model, require_positive("max_launch_speed", max_launch_speed))
     samples = duration / record_interval + 1
     held = (BYTES_PER_BEAD_SAMPLE * model.n_particles + BYTES_PER_SAMPLE) * n_launches * samples
     memory = SAFETY * (BASE_MB + SNAKEMAKE_MB + held / 1e6)
-    work = 2 * n_launches * model.n_particles * (duration / dt) * SECONDS_PER_PARTICLE_STEP
+    work = _integration_seconds(model, n_launches, max_launch_speed, duration, dt)
     seconds = SAFETY * (STARTUP_S + work / min(threads, n_launches))
     return JobNeeds(
         mem_mb=int(100 * math.ceil(memory / 100)),
