@@ -22,6 +22,7 @@ rule ablation_variant:
         f"{LOGS}/ablation/{{variant}}.log",
     benchmark:
         f"{BENCH}/ablation/{{variant}}.tsv"
+    priority: 1
     conda:
         ENV
     params:

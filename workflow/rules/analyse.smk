@@ -148,7 +148,7 @@ rule ssw_track:
         f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
     benchmark:
         f"{BENCH}/simulate/{{model}}_N{{N}}_ssw_track.tsv"
-    priority: 2
+    priority: 1
     conda:
         ENV
     # Half the simulate job's work (collision shots only), same arrays per shot: the

@@ -12,7 +12,9 @@ rule simulate:
         f"{LOGS}/simulate/{{model}}_N{{N}}.log",
     benchmark:
         f"{BENCH}/simulate/{{model}}_N{{N}}.tsv"
-    priority: 2
+    # Simulations and the virtual experiment feed the pulse table, which every later
+    # table waits for: they go first (priority 3); long side jobs next (1).
+    priority: 3
     conda:
         ENV
     threads: simulate_threads
