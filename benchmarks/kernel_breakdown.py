@@ -1,0 +1,201 @@
+"""Where the lean kernel's time goes in bench_integrator.py's DOP853 comparison (issue 14).
+
+Run from the repository root::
+
+    python benchmarks/kernel_breakdown.py              # elastic, as in the DOP853 section
+    python benchmarks/kernel_breakdown.py --eta 0.58e-6 --speed 1.0
+
+One collision in the paper's chain (N = 26, +V0 / -V0, 2 ms, every contact force,
+velocity and the energies recorded every 1 us) at the default step. CPU times, best of
+``--repeat`` interleaved rounds, of:
+
+* ``integrate()``: the public call that bench_integrator.py times;
+* ``integrate()`` for one step (the wrapper's fixed cost);
+* the numba kernel called directly, with freshly allocated outputs and with outputs
+  allocated once before (integrate() minus this is the wrapper and the allocation,
+  whose cost depends on the state of the memory allocator: 0.1 to 0.7 ms measured),
+  and recording only the first and last sample (the difference is the recording);
+* patched copies of ``chain/physics/kernels.py`` (compiled here, cache off): contact
+  events detected but the coarse step kept ("no refinement": the difference is what
+  the refinement costs), and other refinement schemes (EVENT_SUBSTEPS substeps for the
+  event step and the EVENT_AFTERMATH steps after it), each with its energy drift and
+  its force error against the reference solution (the kernel at dt / 8), the two
+  accuracies bench_integrator.py matches DOP853 to, and its "event error": the largest
+  force and energy difference from the converged scheme (64 substeps, 12 steps after)
+  at the same dt, the error the scheme itself adds at contact events.
+
+A diagnostic, not a test: it asserts only that the patched lines still exist.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from bench_integrator import dop853
+
+from chain.physics import kernels
+from chain.physics.integrator import _lean_params, _outputs, integrate
+from chain.physics.model import launch_velocities, uniform_chain
+from chain.physics.simulation import default_time_step
+
+N_BEADS = 26
+DURATION = 2e-3  # s
+RECORD_INTERVAL = 1e-6  # s
+
+#: (label, substeps, aftermath, refine at all)
+SCHEMES = (
+    ("no refinement", 16, 3, False),
+    ("16 substeps, aftermath 0", 16, 0, True),
+    ("16 substeps, aftermath 1", 16, 1, True),
+    ("4 substeps, aftermath 3", 4, 3, True),
+    ("8 substeps, aftermath 3", 8, 3, True),
+    ("64 substeps, aftermath 12", 64, 12, True),
+)
+CONVERGED = "64 substeps, aftermath 12"
+
+
+def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
+    """A copy of chain.physics.kernels with another refinement scheme, as a module."""
+    source = Path(kernels.__file__).read_text()
+    edits = [
+        ("EVENT_SUBSTEPS = 16", f"EVENT_SUBSTEPS = {substeps}"),
+        ("EVENT_AFTERMATH = 3", f"EVENT_AFTERMATH = {aftermath}"),
+        ("cache=True", "cache=False"),
+    ]
+    if not refine:  # detect events (same work) but keep the coarse step
+        edits.append(
+            ("            event = varied or end[2] != slope[2]\n", "            event = False\n")
+        )
+    for old, new in edits:
+        assert old in source, f"kernels.py changed: {old!r} not found"
+        source = source.replace(old, new)
+    name = f"kernel_{substeps}_{aftermath}_{int(refine)}"
+    path = folder / f"{name}.py"
+    path.write_text(source)
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def best_times(contenders: dict, repeat: int) -> dict:
+    best = dict.fromkeys(contenders, math.inf)
+    for _ in range(repeat):
+        for name, function in contenders.items():
+            start = time.process_time()
+            function()
+            best[name] = min(best[name], time.process_time() - start)
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--eta", type=float, default=0.0, help="Kuwabara-Kono time, s")
+    parser.add_argument("--speed", type=float, default=0.3, help="V0, m/s")
+    parser.add_argument(
+        "--rtol",
+        type=float,
+        nargs="*",
+        default=[1.33e-12, 4.22e-13],
+        help="also time DOP853 (bench_integrator.dop853, elastic only) at these rtol",
+    )
+    args = parser.parse_args()
+    model = uniform_chain(N_BEADS, eta=args.eta)
+    velocity = launch_velocities(model, args.speed, args.speed)
+    dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, args.speed))
+    every = round(RECORD_INTERVAL / dt)
+    n_steps = math.ceil(DURATION / dt - 1e-9)
+    n_samples = n_steps // every + 1
+    params = _lean_params(model)
+    links, particles = np.arange(N_BEADS - 1), np.arange(N_BEADS)
+    fine = integrate(model, velocity, DURATION, dt / 8, 8 * every).link_force[0]
+    warm = tuple(out[0] for out in _outputs(1, n_samples, N_BEADS - 1, N_BEADS))
+
+    def direct(module=kernels, record_every=every, outputs=None):
+        def run():
+            out = outputs
+            if out is None:
+                out = tuple(o[0] for o in _outputs(1, n_samples, N_BEADS - 1, N_BEADS))
+            u, v = np.zeros(N_BEADS), velocity[0].copy()
+            status = module._integrate_one(
+                u, v, params, dt, n_steps, record_every, links, particles, out
+            )
+            return out, status
+
+        return run
+
+    contenders = {
+        "integrate()": lambda: integrate(model, velocity, DURATION, dt, every),
+        "integrate(), one step": lambda: integrate(model, velocity, dt, dt, every),
+        "kernel, fresh outputs": direct(),
+        "kernel, warm outputs": direct(outputs=warm),
+        "kernel, no records": direct(record_every=n_steps, outputs=warm),
+    }
+    with tempfile.TemporaryDirectory() as folder:
+        variants = {label: patched_kernel(Path(folder), *rest) for label, *rest in SCHEMES}
+        for label, module in variants.items():
+            contenders[label] = direct(module, outputs=warm)
+        if args.eta == 0:
+            for rtol in args.rtol:
+                contenders[f"DOP853 rtol {rtol:.2e}"] = lambda r=rtol: dop853(
+                    r, velocity[0], np.arange(n_samples) * RECORD_INTERVAL
+                )
+        for function in contenders.values():
+            function()  # compile
+        best = best_times(contenders, args.repeat)
+    print(
+        f"N = {N_BEADS}, V0 = {args.speed} m/s, eta = {args.eta:.2e} s, dt = {dt:.4e} s, "
+        f"{n_steps} steps, {n_samples} samples; CPU ms, best of {args.repeat}"
+    )
+    total = best["integrate()"]
+    runs = {}
+    for label in ["kernel, warm outputs", *variants]:
+        out, (_, _, refined) = contenders[label]()
+        runs[label] = ([a.copy() for a in out], refined)
+    converged = runs[CONVERGED][0]
+    for label, seconds in best.items():
+        line = f"  {label:28s} {seconds * 1e3:7.2f} ms  {seconds / total * 100:5.1f} %"
+        if label in runs:
+            out, refined = runs[label]
+            energy = out[3].sum(axis=1)
+            drift = np.abs(energy - energy[0]).max() / energy[0]
+            error = np.abs(out[0] - fine).max() / fine.max()
+            # The error the scheme adds at the events: distance from the converged one.
+            own = np.abs(out[0] - converged[0]).max() / fine.max()
+            own_energy = np.abs(energy - converged[3].sum(axis=1)).max() / energy[0]
+            line += (
+                f"  refined {refined:4d}  drift {drift:.2e}  force error {error:.2e}"
+                f"  event error {own:.1e} / {own_energy:.1e}"
+            )
+        print(line)
+    kernel = best["kernel, warm outputs"]
+    parts = {
+        "wrapper + output allocation": total - kernel,
+        "recording (1 us)": kernel - best["kernel, no records"],
+        "contact-event refinement": kernel - best["no refinement"],
+    }
+    parts["plain steps + event detection"] = total - sum(parts.values())
+    print("breakdown of integrate():")
+    for label, seconds in parts.items():
+        print(f"  {label:30s} {seconds * 1e3:6.2f} ms  {seconds / total * 100:5.1f} %")
+    plain = parts["plain steps + event detection"]
+    for label, seconds in best.items():
+        if label.startswith("DOP853"):
+            print(
+                f"{label} / integrate() = {seconds / total:.1f}; / plain steps alone = "
+                f"{seconds / plain:.1f} (the ceiling if the wrapper, recording and "
+                "refinement cost nothing)"
+            )
+
+
+if __name__ == "__main__":
+    main()
