@@ -44,6 +44,22 @@ EVENT_AFTERMATH = 3
 
 
 @numba.njit(cache=True, inline="always")
+def _copy_into(target, source):
+    # Element by element: numba compiles ``target[:] = source`` through its general
+    # slice-assignment code, which made a cold compile several seconds longer.
+    for p in range(source.shape[0]):
+        target[p] = source[p]
+
+
+@numba.njit(cache=True, inline="always")
+def _all_finite(values):
+    for p in range(values.shape[0]):
+        if not math.isfinite(values[p]):
+            return False
+    return True
+
+
+@numba.njit(cache=True, inline="always")
 def _hertz_force(stiffness, damping, delta, delta_rate):
     # Returns (elastic, total); total is clipped at zero because a contact never pulls.
     if delta <= 0.0:
@@ -304,9 +320,9 @@ def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag):
         v, v_b = v_b, v
         acc, acc_b = acc_b, acc
     if EVENT_SUBSTEPS % 2 == 1:  # the end state is in the spare buffers
-        u_b[:] = u
-        v_b[:] = v
-        acc_b[:] = acc
+        _copy_into(u_b, u)
+        _copy_into(v_b, v)
+        _copy_into(acc_b, acc)
     return increment, event, slope
 
 
@@ -319,7 +335,9 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     recorded = (masses, k, damping, keys, walls, kind)
     n = u.shape[0]
     work = (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
-    x_u, x_v, x_acc = u.copy(), v.copy(), np.empty(n)
+    x_u, x_v, x_acc = np.empty(n), np.empty(n), np.empty(n)
+    _copy_into(x_u, u)
+    _copy_into(x_v, v)
     y_u, y_v, y_acc = np.empty(n), np.empty(n), np.empty(n)
     slope = _slopes(x_u, x_v, x_acc, im, k, c, keys, springs, walls, drag)
     dissipated = 0.0
@@ -365,8 +383,8 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
             sample = step // record_every
             if not _record(x_u, x_v, dissipated, recorded, links, particles, sample, outputs):
                 status = _NOT_FINITE
-    if status == _OK and not (np.all(np.isfinite(x_u)) and np.all(np.isfinite(x_v))):
+    if status == _OK and not (_all_finite(x_u) and _all_finite(x_v)):
         status = _NOT_FINITE
-    u[:] = x_u
-    v[:] = x_v
+    _copy_into(u, x_u)
+    _copy_into(v, x_v)
     return status, step, refined
