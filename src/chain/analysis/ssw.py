@@ -200,7 +200,8 @@ def measure_ssw(
     result.update(scale=scale, misfit=misfit, floor=floor)
     window = np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)
     prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
-    bump = _distinct_bump(smooth(signal), top, int(window[-1]), prominence)
+    smoothed = smooth(signal)
+    bump = _distinct_bump(smoothed, top, int(window[-1]), prominence)
     unresolved = (math.nan, math.nan, NOT_RESOLVED)
     result.update(residual=unresolved, peak=unresolved)
     if bump is None:
@@ -210,7 +211,7 @@ def measure_ssw(
     result.update(trailing_min_s=float(time[low]), candidate=float(residual[best]))
     if residual[best] > floor:
         result["residual"] = (float(residual[best]), float(time[best]), "")
-        result["peak"] = (float(smooth(signal)[peak]), float(time[peak]), "")
+        result["peak"] = (float(smoothed[peak]), float(time[peak]), "")
     return result
 
 
