@@ -311,6 +311,10 @@ def ssw_table(
         },
         "references": _usable_references(pulses),
     }
+    # The references of each (source, model, N, amplitude), in table order, found once.
+    context["references_of"] = dict(
+        list(context["references"].groupby(_REFERENCE_KEY, sort=False, dropna=False))
+    )
     keys = ["source", "model", "N", "shot", "amplitude"]
     collisions = pulses[pulses["kind"] == "collision"][keys].drop_duplicates()
     rows = []
@@ -325,6 +329,10 @@ def ssw_table(
         for sensor in _CROSSED:
             rows.extend(_sensor_rows(shot, sensor, context))
     return pd.DataFrame(rows, columns=SSW_COLUMNS)
+
+
+#: Columns a reference shares with the collision shots it serves as a template for.
+_REFERENCE_KEY = ["source", "model", "N", "amplitude"]
 
 
 def _usable_references(pulses: pd.DataFrame) -> pd.DataFrame:
@@ -348,13 +356,8 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
         "bead": context["bead_of"][sensor],
         "wave": wave,
     }
-    refs = context["references"]
-    same = refs[
-        (refs["source"] == shot.source)
-        & (refs["model"] == shot.model)
-        & (refs["N"] == shot.N)
-        & (refs["amplitude"] == shot.amplitude)
-    ]
+    same = context["references_of"].get(tuple(getattr(shot, key) for key in _REFERENCE_KEY))
+    same = context["references"].iloc[:0] if same is None else same
     reason = ""
     if crossed is None or not bool(crossed.ok):
         reason = "crossed pulse not measured"
