@@ -464,9 +464,7 @@ def _savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
 
     Cached: every pulse of a sweep sampled alike asks for the same few (read-only).
     """
-    coefficients = tuple(
-        savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2)
-    )
+    coefficients = tuple(savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
     for c in coefficients:
         c.flags.writeable = False
     return coefficients
