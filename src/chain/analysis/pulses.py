@@ -34,9 +34,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.ndimage import convolve1d
-from scipy.optimize import OptimizeWarning, curve_fit
-from scipy.signal import find_peaks, peak_widths, savgol_coeffs
 
 from chain.errors import ParameterError
 
@@ -244,6 +241,10 @@ def find_pulses(
         estimated = estimate_baseline(time, force)
         baseline_N = estimated[0] if baseline_N is None else baseline_N
         noise_N = estimated[1] if noise_N is None else noise_N
+    # Imported here: scipy.signal takes most of a second to import (it loads
+    # scipy.stats), and many jobs import this module for its names only.
+    from scipy.signal import find_peaks, peak_widths
+
     signal = force - baseline_N
     largest = float(signal.max())
     threshold = max(min_snr * noise_N, min_height_N)
@@ -347,6 +348,8 @@ def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
 
 def _half_width_samples(signal: np.ndarray, peak: int) -> float:
     # Full width at half maximum, in samples, interpolated between samples.
+    from scipy.signal import peak_widths  # imported here: see find_pulses
+
     return float(peak_widths(signal, [peak], rel_height=0.5)[0][0])
 
 
@@ -365,6 +368,8 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
     errors (the window no longer moves the estimate beyond the noise), and the fit on
     the most samples is returned.
     """
+    from scipy.optimize import OptimizeWarning, curve_fit  # imported here: see find_pulses
+
     params = np.array([signal[peak], time[peak], tau0])
     windows = [_window(time, params[1], params[2], rising_only)]
     fits = []
@@ -464,6 +469,8 @@ def _savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
 
     Cached: every pulse of a sweep sampled alike asks for the same few (read-only).
     """
+    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
+
     coefficients = tuple(savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
     for c in coefficients:
         c.flags.writeable = False
@@ -473,6 +480,8 @@ def _savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
 @lru_cache(maxsize=64)
 def _savgol_smoothing(length: int) -> np.ndarray:
     """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only, cached)."""
+    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
+
     coefficients = savgol_coeffs(length, 2)
     coefficients.flags.writeable = False
     return coefficients
@@ -485,6 +494,8 @@ def _smoothed_interior(signal: np.ndarray, length: int, lo: int, hi: int) -> np.
     The same convolution as the filter's on just the samples these windows cover (the
     filter's polynomial fits at the edges are never read), so the same values, N.
     """
+    from scipy.ndimage import convolve1d  # imported here: see find_pulses
+
     half = length // 2
     part = signal[lo - half : hi + half]
     return convolve1d(part, _savgol_smoothing(length), mode="constant")[half : half + hi - lo]

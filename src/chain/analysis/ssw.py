@@ -38,9 +38,6 @@ import math
 
 import numpy as np
 import pandas as pd
-from scipy.interpolate import CubicSpline
-from scipy.optimize import least_squares
-from scipy.signal import find_peaks, savgol_coeffs, savgol_filter
 
 from chain.analysis.pulses import estimate_baseline
 from chain.analysis.regression import fit_proportional
@@ -120,6 +117,8 @@ def rescaled_template(time_s, reference_time_s, reference_force_N, scale, arriva
     ref_arrival_s : float
         Arrival time T_ref of the reference pulse, s.
     """
+    from scipy.interpolate import CubicSpline  # imported here: see measure_ssw
+
     spline = CubicSpline(reference_time_s, reference_force_N, extrapolate=False)
     return _template(spline, np.asarray(time_s, dtype=float), scale, arrival_s, ref_arrival_s)
 
@@ -172,6 +171,10 @@ def measure_ssw(
         ``candidate`` the residual maximum read, resolved or not, ``trailing_min_s`` the time of
         the crossed pulse's trailing minimum (NaN without a distinct bump).
     """
+    # Imported here: scipy.interpolate and scipy.signal take most of a second to import,
+    # and most jobs that import this module (for its tables' names) never measure.
+    from scipy.interpolate import CubicSpline
+
     time = np.asarray(time_s, dtype=float)
     signal = np.asarray(force_N, dtype=float) - baseline_N
     ref_signal = np.asarray(reference_force_N, dtype=float) - reference_baseline_N
@@ -221,6 +224,8 @@ def _align_template(time, signal, arrival, tau, scale_guess, spline, ref_arrival
     Returns (a, arrival s, the rising edge as a slice, index of the top sample), or None
     when the pulse has fewer than 6 samples within tau of its arrival.
     """
+    from scipy.optimize import least_squares  # imported here: see measure_ssw
+
     near = np.flatnonzero(np.abs(time - arrival) < tau)
     if near.size < 6:
         return None
@@ -239,6 +244,8 @@ def _align_template(time, signal, arrival, tau, scale_guess, spline, ref_arrival
 
 def _smoother(time, tau):
     """Quadratic Savitzky-Golay smoothing tau/2 long, and its gain on white noise."""
+    from scipy.signal import savgol_coeffs, savgol_filter  # imported here: see measure_ssw
+
     dt = float(np.median(np.diff(time)))
     length = round(0.5 * tau / dt) | 1
     if not 5 <= length < len(time):
@@ -254,6 +261,8 @@ def _distinct_bump(smoothed, top: int, last: int, prominence: float):
     Prominence is measured within [top, last], so the crossed pulse itself bounds the
     bump on the near side and the trailing minimum is the lowest point between them.
     """
+    from scipy.signal import find_peaks  # imported here: see measure_ssw
+
     region = smoothed[top : last + 1]
     peaks, properties = find_peaks(region, prominence=prominence)
     if not peaks.size:
