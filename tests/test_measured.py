@@ -501,3 +501,47 @@ def test_readme_example_metadata_follows_the_schema():
     meta = parse_metadata(yaml.safe_load("format: hertzchain-measured-traces/1" + block))
     assert meta.samples == 2600 and meta.adc_range_V == 2.0 and meta.adc_bits == 12
     assert [s.amplitude for s in meta.shots] == [0, 0, 0, 1]
+
+
+# ----------------------------------------------------------------------------- one parse
+
+
+def test_load_reuses_the_checked_samples_and_a_cached_verdict_reads_the_file(tmp_path):
+    """A load parses each shot file once (the check's samples); after a cache hit the
+    file is read by the loader: the same table either way."""
+    from chain.apparatus.dataset_check import check_dataset
+    from chain.apparatus.shot_files import read_shot_csv
+
+    check = check_dataset(EXAMPLE, keep_data=True)
+    assert sorted(check.data) == list(range(len(check.metadata.shots)))
+    time, volts = read_shot_csv(EXAMPLE / check.metadata.shots[0].file, check.metadata.sensor_beads)
+    np.testing.assert_array_equal(check.data[0][:, 0], time)
+    np.testing.assert_array_equal(check.data[0][:, 1:].T, volts)
+    assert check_dataset(EXAMPLE).data == {}  # not kept unless asked
+    fresh = load_dataset(EXAMPLE)
+    load_dataset(EXAMPLE, cache_dir=tmp_path)  # fills the cache
+    assert check_dataset(EXAMPLE, cache_dir=tmp_path, keep_data=True).data == {}
+    pd.testing.assert_frame_equal(load_dataset(EXAMPLE, cache_dir=tmp_path), fresh)
+
+
+def test_shot_file_text_is_that_of_numpy_savetxt(tmp_path):
+    """write_shot_csv formats all rows at once: the bytes of np.savetxt with its formats."""
+    import io
+
+    rng = np.random.default_rng(5)
+    time = 3.3e-7 + 1e-6 * np.arange(50)
+    volts = np.round(rng.normal(0, 2, (2, 50)), 3)
+    volts[0, :3] = -0.0
+    volts[1, 4] = 1.234567891e-9
+    write_shot_csv(tmp_path / "a.csv", time, volts, (9, 17))
+    expected = io.StringIO()
+    np.savetxt(
+        expected,
+        np.column_stack([time, (volts + 0.0).T]),
+        fmt=["%.10g", "%.7g", "%.7g"],
+        delimiter=",",
+        header="t_s,bead9_V,bead17_V",
+        comments="",
+    )
+    assert (tmp_path / "a.csv").read_text() == expected.getvalue()
+    assert "-0," not in expected.getvalue()

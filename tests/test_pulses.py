@@ -222,3 +222,19 @@ def test_pulse_table_is_the_public_one():
     import chain.analysis
 
     assert chain.pulse_table is pulse_table is chain.analysis.pulse_table
+
+
+def test_smoothed_interior_is_the_savgol_filter_bit_for_bit():
+    """The peak estimator smooths only the samples it reads: the same values as
+    scipy's filter on the whole signal, away from the filter's polynomial edges."""
+    from scipy.signal import savgol_filter
+
+    from chain.analysis.pulses import _smoothed_interior
+
+    rng = np.random.default_rng(3)
+    signal = cos6_pulse(TIME_S, PEAK_N, ARRIVAL_S, TAU_S) + rng.normal(0, 2.0, TIME_S.size)
+    for length in (3, 5, 21, 41):
+        half = length // 2
+        full = savgol_filter(signal, length, 2)
+        for lo, hi in ((half, half + 7), (380, 420), (TIME_S.size - half - 9, TIME_S.size - half)):
+            np.testing.assert_array_equal(_smoothed_interior(signal, length, lo, hi), full[lo:hi])

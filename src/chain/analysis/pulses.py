@@ -31,10 +31,9 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import OptimizeWarning, curve_fit
-from scipy.signal import find_peaks, peak_widths, savgol_coeffs, savgol_filter
 
 from chain.errors import ParameterError
 
@@ -242,6 +241,10 @@ def find_pulses(
         estimated = estimate_baseline(time, force)
         baseline_N = estimated[0] if baseline_N is None else baseline_N
         noise_N = estimated[1] if noise_N is None else noise_N
+    # Imported here: scipy.signal takes most of a second to import (it loads
+    # scipy.stats), and many jobs import this module for its names only.
+    from scipy.signal import find_peaks, peak_widths
+
     signal = force - baseline_N
     largest = float(signal.max())
     threshold = max(min_snr * noise_N, min_height_N)
@@ -345,6 +348,8 @@ def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
 
 def _half_width_samples(signal: np.ndarray, peak: int) -> float:
     # Full width at half maximum, in samples, interpolated between samples.
+    from scipy.signal import peak_widths  # imported here: see find_pulses
+
     return float(peak_widths(signal, [peak], rel_height=0.5)[0][0])
 
 
@@ -363,6 +368,8 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
     errors (the window no longer moves the estimate beyond the noise), and the fit on
     the most samples is returned.
     """
+    from scipy.optimize import OptimizeWarning, curve_fit  # imported here: see find_pulses
+
     params = np.array([signal[peak], time[peak], tau0])
     windows = [_window(time, params[1], params[2], rising_only)]
     fits = []
@@ -416,12 +423,14 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
     # pulse spans few samples this is the 3-point parabolic interpolation.
     length = max(round(0.5 * tau0 / dt) | 1, 3)
     half = length // 2
-    smooth = savgol_filter(signal, length, 2) if len(signal) > length else signal
     lo, hi = max(peak - half, half), min(peak + half + 1, len(signal) - half)
     if hi <= lo:
         return PulseFit.failed("peak at the segment edge")
-    centre = lo + int(np.argmax(smooth[lo:hi]))
-    coefficients = [savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2)]
+    if len(signal) > length:
+        centre = lo + int(np.argmax(_smoothed_interior(signal, length, lo, hi)))
+    else:
+        centre = lo + int(np.argmax(signal[lo:hi]))
+    coefficients = _savgol_dot_coefficients(length, dt)
     for _ in range(2):  # re-centre once on the sample nearest the vertex
         around = signal[centre - half : centre + half + 1]
         value, slope, curvature = (float(np.dot(c, around)) for c in coefficients)
@@ -451,3 +460,42 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
         float(tau_error),
         n_samples=length,
     )
+
+
+@lru_cache(maxsize=64)
+def _savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
+    """Quadratic Savitzky-Golay coefficients of the value, slope (1/s) and curvature
+    (1/s^2) at the centre of ``length`` samples ``dt`` s apart (for ``np.dot``).
+
+    Cached: every pulse of a sweep sampled alike asks for the same few (read-only).
+    """
+    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
+
+    coefficients = tuple(savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
+    for c in coefficients:
+        c.flags.writeable = False
+    return coefficients
+
+
+@lru_cache(maxsize=64)
+def _savgol_smoothing(length: int) -> np.ndarray:
+    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only, cached)."""
+    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
+
+    coefficients = savgol_coeffs(length, 2)
+    coefficients.flags.writeable = False
+    return coefficients
+
+
+def _smoothed_interior(signal: np.ndarray, length: int, lo: int, hi: int) -> np.ndarray:
+    """``savgol_filter(signal, length, 2)[lo:hi]`` for ``length // 2 <= lo < hi <=
+    len(signal) - length // 2``, where every window lies inside the signal.
+
+    The same convolution as the filter's on just the samples these windows cover (the
+    filter's polynomial fits at the edges are never read), so the same values, N.
+    """
+    from scipy.ndimage import convolve1d  # imported here: see find_pulses
+
+    half = length // 2
+    part = signal[lo - half : hi + half]
+    return convolve1d(part, _savgol_smoothing(length), mode="constant")[half : half + hi - lo]

@@ -195,6 +195,10 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
     log_x, log_y = np.log(x), np.log(y)
     if method == "loglog":
         if sigma is None:
+            # Imported here: scipy.stats takes most of a second to import, and most jobs
+            # that import this module never fit a power law.
+            from scipy.stats import linregress
+
             line = linregress(log_x, log_y)
             exponent, exponent_error = line.slope, line.stderr
             log_a, log_a_error = line.intercept, line.intercept_stderr
@@ -215,6 +219,8 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
             n,
             method,
         )
+    from scipy.optimize import curve_fit  # imported here: see the loglog branch
+
     start = fit_power_law(x, y, method="loglog")
     params, covariance = curve_fit(
         lambda u, a, p: a * u**p,

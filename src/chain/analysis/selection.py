@@ -123,14 +123,15 @@ def select_shots(
 
     rows = []
     seen = set()
+    pulses_of = _first_pulses(table)
     for key, group in table.groupby(_KEY, sort=False):
         seen.add(tuple(key))
         first = group.iloc[0]
         base = dict(zip(_KEY, key), kind=first["kind"], amplitude=int(first["amplitude"]))
         if first["kind"] == "collision":
-            rows.append({**base, **_judge_collision(group, tolerance)})
+            rows.append({**base, **_judge_collision(pulses_of[tuple(key)], tolerance)})
         else:
-            rows.append({**base, **_judge_reference(group)})
+            rows.append({**base, **_judge_reference(pulses_of[tuple(key)])})
     if shots is not None:
         absent = shots.drop_duplicates(_KEY)
         for record in absent.itertuples(index=False):
@@ -161,14 +162,28 @@ def _rejected(reason: str, left=math.nan, right=math.nan, mismatch=math.nan) -> 
     }
 
 
-def _pulse(group: pd.DataFrame, sensor: str, role: str):
-    """The amplitude of one pulse, or (None, why it is missing)."""
-    rows = group[(group["sensor"] == sensor) & (group["role"] == role)]
+def _first_pulses(table: pd.DataFrame) -> dict[tuple, dict[tuple, dict]]:
+    """Shot key (source, model, N, shot) -> (sensor, role) -> the first row of that
+    pulse in ``table``, as a dict with its ``ok`` flag (:func:`is_ok`) under ``_ok``.
+
+    Built once, so that judging a shot looks its pulses up instead of filtering the table.
+    """
+    firsts = table.assign(_ok=is_ok(table)).drop_duplicates([*_KEY, "sensor", "role"])
+    pulses: dict[tuple, dict[tuple, dict]] = {}
+    for record in firsts.to_dict("records"):
+        shot = pulses.setdefault(tuple(record[c] for c in _KEY), {})
+        shot[(record["sensor"], record["role"])] = record
+    return pulses
+
+
+def _pulse(pulses: dict[tuple, dict], sensor: str, role: str):
+    """The amplitude of one pulse of a shot (:func:`_first_pulses`), or (None, why it
+    is missing)."""
+    row = pulses.get((sensor, role))
     label = f"{role} pulse at {sensor}"
-    if rows.empty:
+    if row is None:
         return None, f"no pulse detected ({label}: no row)"
-    row = rows.iloc[0]
-    if not is_ok(rows).iloc[0]:
+    if not row["_ok"]:
         reason = str(row["reason"]) if "reason" in row and isinstance(row["reason"], str) else ""
         return None, f"{reason or 'fit failed'} ({label})"
     force = float(row["F_m_N"])
@@ -177,9 +192,9 @@ def _pulse(group: pd.DataFrame, sensor: str, role: str):
     return force, ""
 
 
-def _judge_collision(group: pd.DataFrame, tolerance: float) -> dict:
-    left, why_left = _pulse(group, "S1", "incident")
-    right, why_right = _pulse(group, "S2", "incident")
+def _judge_collision(pulses: dict[tuple, dict], tolerance: float) -> dict:
+    left, why_left = _pulse(pulses, "S1", "incident")
+    right, why_right = _pulse(pulses, "S2", "incident")
     if left is None or right is None:
         why = "; ".join(w for w in (why_left, why_right) if w)
         return _rejected(why, left if left else math.nan, right if right else math.nan)
@@ -197,12 +212,12 @@ def _judge_collision(group: pd.DataFrame, tolerance: float) -> dict:
     }
 
 
-def _judge_reference(group: pd.DataFrame) -> dict:
-    sensors = sorted(group["sensor"].unique()) or ["S1"]
+def _judge_reference(pulses: dict[tuple, dict]) -> dict:
+    sensors = sorted({sensor for sensor, _ in pulses}) or ["S1"]
     forces = {}
     problems = []
     for sensor in sensors:
-        force, why = _pulse(group, sensor, "reference")
+        force, why = _pulse(pulses, sensor, "reference")
         forces[sensor] = force
         if force is None:
             problems.append(why)

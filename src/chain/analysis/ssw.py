@@ -38,9 +38,6 @@ import math
 
 import numpy as np
 import pandas as pd
-from scipy.interpolate import CubicSpline
-from scipy.optimize import least_squares
-from scipy.signal import find_peaks, savgol_coeffs, savgol_filter
 
 from chain.analysis.pulses import estimate_baseline
 from chain.analysis.regression import fit_proportional
@@ -120,6 +117,8 @@ def rescaled_template(time_s, reference_time_s, reference_force_N, scale, arriva
     ref_arrival_s : float
         Arrival time T_ref of the reference pulse, s.
     """
+    from scipy.interpolate import CubicSpline  # imported here: see measure_ssw
+
     spline = CubicSpline(reference_time_s, reference_force_N, extrapolate=False)
     return _template(spline, np.asarray(time_s, dtype=float), scale, arrival_s, ref_arrival_s)
 
@@ -172,6 +171,10 @@ def measure_ssw(
         ``candidate`` the residual maximum read, resolved or not, ``trailing_min_s`` the time of
         the crossed pulse's trailing minimum (NaN without a distinct bump).
     """
+    # Imported here: scipy.interpolate and scipy.signal take most of a second to import,
+    # and most jobs that import this module (for its tables' names) never measure.
+    from scipy.interpolate import CubicSpline
+
     time = np.asarray(time_s, dtype=float)
     signal = np.asarray(force_N, dtype=float) - baseline_N
     ref_signal = np.asarray(reference_force_N, dtype=float) - reference_baseline_N
@@ -200,7 +203,8 @@ def measure_ssw(
     result.update(scale=scale, misfit=misfit, floor=floor)
     window = np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)
     prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
-    bump = _distinct_bump(smooth(signal), top, int(window[-1]), prominence)
+    smoothed = smooth(signal)
+    bump = _distinct_bump(smoothed, top, int(window[-1]), prominence)
     unresolved = (math.nan, math.nan, NOT_RESOLVED)
     result.update(residual=unresolved, peak=unresolved)
     if bump is None:
@@ -210,7 +214,7 @@ def measure_ssw(
     result.update(trailing_min_s=float(time[low]), candidate=float(residual[best]))
     if residual[best] > floor:
         result["residual"] = (float(residual[best]), float(time[best]), "")
-        result["peak"] = (float(smooth(signal)[peak]), float(time[peak]), "")
+        result["peak"] = (float(smoothed[peak]), float(time[peak]), "")
     return result
 
 
@@ -220,6 +224,8 @@ def _align_template(time, signal, arrival, tau, scale_guess, spline, ref_arrival
     Returns (a, arrival s, the rising edge as a slice, index of the top sample), or None
     when the pulse has fewer than 6 samples within tau of its arrival.
     """
+    from scipy.optimize import least_squares  # imported here: see measure_ssw
+
     near = np.flatnonzero(np.abs(time - arrival) < tau)
     if near.size < 6:
         return None
@@ -238,6 +244,8 @@ def _align_template(time, signal, arrival, tau, scale_guess, spline, ref_arrival
 
 def _smoother(time, tau):
     """Quadratic Savitzky-Golay smoothing tau/2 long, and its gain on white noise."""
+    from scipy.signal import savgol_coeffs, savgol_filter  # imported here: see measure_ssw
+
     dt = float(np.median(np.diff(time)))
     length = round(0.5 * tau / dt) | 1
     if not 5 <= length < len(time):
@@ -253,6 +261,8 @@ def _distinct_bump(smoothed, top: int, last: int, prominence: float):
     Prominence is measured within [top, last], so the crossed pulse itself bounds the
     bump on the near side and the trailing minimum is the lowest point between them.
     """
+    from scipy.signal import find_peaks  # imported here: see measure_ssw
+
     region = smoothed[top : last + 1]
     peaks, properties = find_peaks(region, prominence=prominence)
     if not peaks.size:
@@ -310,6 +320,10 @@ def ssw_table(
         },
         "references": _usable_references(pulses),
     }
+    # The references of each (source, model, N, amplitude), in table order, found once.
+    context["references_of"] = dict(
+        list(context["references"].groupby(_REFERENCE_KEY, sort=False, dropna=False))
+    )
     keys = ["source", "model", "N", "shot", "amplitude"]
     collisions = pulses[pulses["kind"] == "collision"][keys].drop_duplicates()
     rows = []
@@ -324,6 +338,10 @@ def ssw_table(
         for sensor in _CROSSED:
             rows.extend(_sensor_rows(shot, sensor, context))
     return pd.DataFrame(rows, columns=SSW_COLUMNS)
+
+
+#: Columns a reference shares with the collision shots it serves as a template for.
+_REFERENCE_KEY = ["source", "model", "N", "amplitude"]
 
 
 def _usable_references(pulses: pd.DataFrame) -> pd.DataFrame:
@@ -347,13 +365,8 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
         "bead": context["bead_of"][sensor],
         "wave": wave,
     }
-    refs = context["references"]
-    same = refs[
-        (refs["source"] == shot.source)
-        & (refs["model"] == shot.model)
-        & (refs["N"] == shot.N)
-        & (refs["amplitude"] == shot.amplitude)
-    ]
+    same = context["references_of"].get(tuple(getattr(shot, key) for key in _REFERENCE_KEY))
+    same = context["references"].iloc[:0] if same is None else same
     reason = ""
     if crossed is None or not bool(crossed.ok):
         reason = "crossed pulse not measured"

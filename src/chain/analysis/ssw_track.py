@@ -38,7 +38,6 @@ from collections.abc import Callable
 
 import numpy as np
 import pandas as pd
-from scipy.signal import find_peaks
 
 from chain.errors import ParameterError
 
@@ -186,6 +185,10 @@ def _first_bump(signal, main_index: int, window_s: float, floor_N: float, time) 
     ``floor_N``) within ``window_s`` of it, or -1."""
     if not np.isfinite(window_s):
         return -1
+    # Imported here: scipy.signal takes most of a second to import (it loads
+    # scipy.stats), and most jobs that import this module read its tables only.
+    from scipy.signal import find_peaks
+
     segment = signal[main_index:]
     peaks, _ = find_peaks(segment, height=floor_N, prominence=floor_N)
     peaks = peaks[time[main_index + peaks] - time[main_index] <= window_s]

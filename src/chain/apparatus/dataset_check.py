@@ -16,6 +16,8 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from chain.apparatus.measured_format import (
     MAX_PROBLEMS,
     METADATA_FILE,
@@ -49,12 +51,17 @@ class DatasetCheck:
     faults : dict of int to tuple of str
         Shot index -> its dead or saturated channels, one line each (the data parse,
         but the shot cannot be trusted).
+    data : dict of int to array
+        With ``keep_data``: shot index -> its samples as parsed by the check, (S, 1 +
+        n_sensors), time (s) then volts (V), for the shots read (not those whose verdict
+        came from the cache), so that a load need not parse them again.
     """
 
     folder: str
     metadata: DatasetMetadata
     problems: tuple[str, ...] = ()
     faults: dict[int, tuple[str, ...]] = field(default_factory=dict)
+    data: dict[int, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
     def raise_problems(self, limit: int = MAX_PROBLEMS) -> None:
         """Raise :class:`MeasuredDataError` listing the problems (up to ``limit``), if any."""
@@ -76,7 +83,8 @@ def _rules(meta: DatasetMetadata) -> str:
     )
 
 
-def _check_file(path: Path, meta: DatasetMetadata, limit: int) -> dict:
+def _check_file(path: Path, meta: DatasetMetadata, limit: int) -> tuple[dict, np.ndarray | None]:
+    """The verdict on one shot file, and its samples (None when it has problems)."""
     data, problems = shot_file_problems(
         path, meta.sensor_beads, meta.sampling_interval_s, meta.samples, limit
     )
@@ -84,11 +92,12 @@ def _check_file(path: Path, meta: DatasetMetadata, limit: int) -> dict:
     if data is not None:
         limits = saturation_limits(meta.adc_range_V, meta.adc_bits)
         faults = channel_faults(str(path), data[:, 1:].T, meta.sensor_beads, limits)
-    return {"problems": problems, "faults": faults}
+    return {"problems": problems, "faults": faults}, data
 
 
 def _cached_check(path: Path, meta: DatasetMetadata, rules: str, cache: Path | None, limit):
-    """:func:`_check_file`, remembered under the hash of the rules and the file's bytes."""
+    """:func:`_check_file`, the verdict remembered under the hash of the rules and the
+    file's bytes (the samples are None on a cache hit: the file was not parsed)."""
     if cache is None:
         return _check_file(path, meta, limit)
     digest = hashlib.sha256(rules.encode())
@@ -98,14 +107,14 @@ def _cached_check(path: Path, meta: DatasetMetadata, rules: str, cache: Path | N
     name = str(path)
     try:
         stored = json.loads(entry.read_text(encoding="utf-8"))
-        return {kind: [m.replace(_FILE, name) for m in stored[kind]] for kind in stored}
+        return {kind: [m.replace(_FILE, name) for m in stored[kind]] for kind in stored}, None
     except (OSError, ValueError, KeyError, TypeError):
         pass  # not cached yet, or an unreadable entry: check again
-    result = _check_file(path, meta, limit)
+    result, data = _check_file(path, meta, limit)
     generic = {kind: [m.replace(name, _FILE) for m in result[kind]] for kind in result}
     entry.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(json.dumps(generic), entry)
-    return result
+    return result, data
 
 
 def check_dataset(
@@ -113,6 +122,7 @@ def check_dataset(
     *,
     cache_dir: str | os.PathLike | None = None,
     limit: int = MAX_PROBLEMS,
+    keep_data: bool = False,
 ) -> DatasetCheck:
     """Check a measured dataset: its metadata and every shot file it lists.
 
@@ -124,6 +134,8 @@ def check_dataset(
         Folder of the verdict cache (created if needed); None checks every file.
     limit : int
         Stop after this many problems (the dataset is bad either way).
+    keep_data : bool
+        Keep the samples of the shot files parsed (``DatasetCheck.data``).
 
     Returns
     -------
@@ -142,6 +154,7 @@ def check_dataset(
     cache = None if cache_dir is None else Path(cache_dir)
     problems: list[str] = []
     faults: dict[int, tuple[str, ...]] = {}
+    kept: dict[int, np.ndarray] = {}
     for shot, entry in enumerate(meta.shots):
         path = folder / entry.file
         if not path.is_file():
@@ -151,8 +164,10 @@ def check_dataset(
                 f"{entry.file!r}"
             )
         else:
-            result = _cached_check(path, meta, rules, cache, limit)
+            result, data = _cached_check(path, meta, rules, cache, limit)
             problems += result["problems"]
             if result["faults"]:
                 faults[shot] = tuple(result["faults"])
-    return DatasetCheck(str(folder), meta, tuple(problems), faults)
+            if keep_data and data is not None:
+                kept[shot] = data
+    return DatasetCheck(str(folder), meta, tuple(problems), faults, kept)
