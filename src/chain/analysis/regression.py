@@ -179,11 +179,6 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
     PowerLawFit
         NaN values with fewer than 3 points.
     """
-    # scipy.stats takes about a second to import, which jobs and the Snakefile that
-    # import this module without fitting a free power law need not pay.
-    from scipy.optimize import curve_fit
-    from scipy.stats import linregress
-
     if method not in POWER_LAW_METHODS:
         raise ParameterError(f"method must be one of {POWER_LAW_METHODS}, got {method!r}")
     x, y, weight = _points(x, y, sigma)
