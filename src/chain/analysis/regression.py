@@ -28,6 +28,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import curve_fit
+from scipy.stats import linregress
 
 from chain.errors import ParameterError
 
@@ -179,11 +181,6 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
     PowerLawFit
         NaN values with fewer than 3 points.
     """
-    # Imported here: most jobs that import this module never fit, and scipy.optimize and
-    # scipy.stats cost them about 1 s of start-up.
-    from scipy.optimize import curve_fit
-    from scipy.stats import linregress
-
     if method not in POWER_LAW_METHODS:
         raise ParameterError(f"method must be one of {POWER_LAW_METHODS}, got {method!r}")
     x, y, weight = _points(x, y, sigma)
