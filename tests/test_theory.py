@@ -44,6 +44,14 @@ def test_hertz_time_constant_is_the_quadrature(tol):
     assert round(HERTZ_TIME_CONSTANT, 2) == PAPER_TIME_CONSTANT  # Landau & Lifshitz's 2.94
 
 
+def test_hertz_time_constant_is_the_gamma_ratio():
+    """The written-out constant is 2 sqrt(pi) Gamma(7/5) / Gamma(9/10) to the last bit,
+    with scipy's Gamma (the value every table was computed with)."""
+    from scipy.special import gamma
+
+    assert HERTZ_TIME_CONSTANT == 2.0 * math.sqrt(math.pi) * gamma(1.4) / gamma(0.9)
+
+
 def test_paper_ballistic_constant_is_4974(steel, radius, tol):
     """Eq. 6 as printed gives C_bal = 49.74 us N^(1/6) for 100C6 beads of R = 13 mm."""
     value_us = ballistic_delay_constant_paper(steel, radius) / US

@@ -26,7 +26,6 @@ import numpy as np
 import pandas as pd
 
 from chain.analysis.delays import delay_fit_table, delay_table
-from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.rows import flag_unusable
 from chain.analysis.selection import select_shots
 from chain.errors import ParameterError
@@ -181,7 +180,9 @@ def run_variant(
     DataFrame
         :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
     """
-    # Imported here: chain.apparatus pulls in the simulation core.
+    # Imported here: chain.apparatus pulls in the simulation core, and the pulse fits
+    # scipy.signal, which the ablation table job (it only reads fits) does not need.
+    from chain.analysis.pulse_rows import pulse_table
     from chain.apparatus.measured import load_dataset
     from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 

@@ -32,6 +32,10 @@ STYLE = {
     "ytick.labelsize": 7,
     "axes.spines.top": False,
     "axes.spines.right": False,
+    # Titles at the top of their axes. The default (None) moves a title above whatever
+    # sits on top of the axes (top ticks, an offset text), which no figure here has, and
+    # costs a third of the layout time; same bytes.
+    "axes.titley": 1.0,
     "lines.linewidth": 1.2,
     "pdf.fonttype": 42,
     "svg.hashsalt": "hertzchain",
