@@ -183,10 +183,6 @@ def track_wave(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict:
 def _first_bump(signal, main_index: int, window_s: float, floor_N: float, time) -> int:
     """Index of the first maximum past the main peak (height and prominence above
     ``floor_N``) within ``window_s`` of it, or -1."""
-    # Imported here: the figure and table jobs that read this module's tables and
-    # constants never track, and scipy.signal costs them about 1 s of start-up.
-    from scipy.signal import find_peaks
-
     if not np.isfinite(window_s):
         return -1
     # Imported here: scipy.signal takes most of a second to import (it loads
