@@ -12,9 +12,9 @@ rule simulate:
         f"{LOGS}/simulate/{{model}}_N{{N}}.log",
     benchmark:
         f"{BENCH}/simulate/{{model}}_N{{N}}.tsv"
-    # Simulations and the virtual experiment feed the pulse table, which every later
-    # table waits for: they go first (priority 3); long side jobs next (1).
-    priority: 3
+    # First (3-4, see simulate_priority), with the virtual experiment (3); long side
+    # jobs next (1).
+    priority: simulate_priority
     conda:
         ENV
     threads: simulate_threads
