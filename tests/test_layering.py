@@ -6,7 +6,7 @@ figures, and the report without an integrator.
     report                 -> analysis, physics.theory/materials
     apparatus | analysis   (side by side, no arrow between them)
     physics                -> errors only
-    errors, atomic, traces, labels, _lazy
+    errors, atomic, csv_text, traces, labels, _lazy
 """
 
 from __future__ import annotations
@@ -17,7 +17,15 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "chain"
-BOTTOM = {"chain", "chain._lazy", "chain.errors", "chain.atomic", "chain.traces", "chain.labels"}
+BOTTOM = {
+    "chain",
+    "chain._lazy",
+    "chain.errors",
+    "chain.atomic",
+    "chain.csv_text",
+    "chain.traces",
+    "chain.labels",
+}
 
 #: Wing -> the chain modules or wings (prefixes) it may import.
 ALLOWED = {
@@ -33,6 +41,7 @@ ALLOWED = {
         "chain._lazy",
         "chain.errors",
         "chain.atomic",
+        "chain.csv_text",
         "chain.traces",
         "chain.labels",
         "chain.physics",

@@ -15,6 +15,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from chain.csv_text import csv_text
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -77,14 +79,10 @@ def write_text_atomic(text: str, path: str | os.PathLike) -> None:
         stream.write(text)
 
 
-#: CSV float format: 10 significant digits, ample for forces and times, and fixed bytes.
-FLOAT_FORMAT = "%.10g"
-
-
 def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
-    """Write ``table`` as CSV (fixed float format, ``\\n`` line ends) atomically: an
-    interrupted write never leaves a partial file under the final name
-    (:func:`atomic_output`).
+    """Write ``table`` as CSV (no index, floats as ``chain.csv_text.FLOAT_FORMAT``,
+    ``\\n`` line ends) atomically: an interrupted write never leaves a partial file under
+    the final name (:func:`atomic_output`).
 
     Parameters
     ----------
@@ -93,8 +91,7 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     path : path
         Destination; parent folders are created.
     """
-    with atomic_output(path) as temporary, open(temporary, "w", newline="") as stream:
-        table.to_csv(stream, index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
+    write_text_atomic(csv_text(table), path)
 
 
 def replace_folder(staging: Path, out: Path) -> None:
