@@ -40,8 +40,15 @@ TABLES = {
     "header that needs quotes": lambda: pd.DataFrame({"a,b": [1.0], "c": [2.0]}),
     "one column": lambda: pd.DataFrame({"note": ["", "a"]}),
     "no rows": lambda: pd.DataFrame({"a": pd.Series([], dtype=float), "b": []}),
-    "float32 and nullable ints": lambda: pd.DataFrame(
-        {"a": np.array([0.1, 0.2], dtype=np.float32), "b": pd.array([1, None], dtype="Int64")}
+    "float32": lambda: pd.DataFrame({"a": np.array([0.1, 0.2], dtype=np.float32), "b": [1.0, 2.0]}),
+    "nullable ints": lambda: pd.DataFrame(
+        {"a": pd.array([17, None], dtype="Int64"), "b": [1.0, 2.0]}
+    ),
+    "nullable floats and booleans": lambda: pd.DataFrame(
+        {"a": pd.array([1.5, None], dtype="Float64"), "b": pd.array([True, None], dtype="boolean")}
+    ),
+    "floats in an object column": lambda: pd.DataFrame(
+        {"a": np.array([17.0, np.nan], dtype=object), "b": [1.0, 2.0]}
     ),
     "mixed object column": lambda: pd.DataFrame({"a": ["x", 1.5, 2], "b": [1, 2, 3]}),
     "categories": lambda: pd.DataFrame({"a": pd.Categorical(["x", "y"]), "b": [0.5, 1.5]}),

@@ -47,13 +47,14 @@ def csv_text(table: pd.DataFrame) -> str:
 
 def _column_text(column: pd.Series) -> list[str] | None:
     """The column's cells as text, or None when pandas would write them differently."""
-    kind = column.dtype.kind
+    dtype = column.dtype
     values = column.to_numpy()
-    if kind == "f" and column.dtype == np.float64:
+    # numpy dtypes only: pandas' nullable Int64, Float64 and boolean are its own.
+    if dtype == np.float64:
         return [FLOAT_FORMAT % x if x == x else "" for x in values.tolist()]
-    if kind in "iub":
+    if isinstance(dtype, np.dtype) and dtype.kind in "iub":
         return list(map(str, values.tolist()))
-    if kind in "OT" or str(column.dtype) == "string":
+    if dtype == np.dtype(object) or str(dtype) == "string":
         missing = column.isna().to_numpy()
         # Checked once per distinct value: text columns are labels that repeat.
         if all(_plain_text(x) for x in column[~missing].unique()):
