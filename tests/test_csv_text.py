@@ -61,8 +61,19 @@ def test_same_bytes_as_pandas(name):
     assert csv_text(table) == pandas_text(table)
 
 
+@pytest.mark.parametrize("name", ["trace-like", "text with missing values", "pandas string dtype"])
+def test_tables_of_the_results_are_not_handed_to_pandas(name, monkeypatch):
+    table = TABLES[name]()
+    expected = pandas_text(table)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("handed to pandas")
+
+    monkeypatch.setattr(pd.DataFrame, "to_csv", refuse)
+    assert csv_text(table) == expected
+
+
 def test_the_fast_path_formats_the_trace_columns():
-    # The trace-like table is not handed to pandas: its cells are formatted here.
     text = csv_text(TABLES["trace-like"]())
     assert "1.701785255e-314" not in text and "1e-314" in text
     assert ",-0\n" in text and ",inf\n" in text and ",-inf\n" in text and ",\n" in text

@@ -15,8 +15,6 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from chain.csv_text import csv_text
-
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -91,6 +89,8 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     path : path
         Destination; parent folders are created.
     """
+    from chain.csv_text import csv_text  # here: it imports pandas, which a table has loaded
+
     write_text_atomic(csv_text(table), path)
 
 

@@ -11,12 +11,8 @@ which path wrote them (``tests/test_csv_text.py`` compares the two).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
-
-if TYPE_CHECKING:
-    import pandas as pd
+import pandas as pd
 
 #: CSV float format: 10 significant digits, ample for forces and times, and fixed bytes.
 FLOAT_FORMAT = "%.10g"
@@ -54,7 +50,7 @@ def _column_text(column: pd.Series) -> list[str] | None:
         return [FLOAT_FORMAT % x if x == x else "" for x in values.tolist()]
     if isinstance(dtype, np.dtype) and dtype.kind in "iub":
         return list(map(str, values.tolist()))
-    if dtype == np.dtype(object) or str(dtype) == "string":
+    if dtype == np.dtype(object) or isinstance(dtype, pd.StringDtype):
         missing = column.isna().to_numpy()
         # Checked once per distinct value: text columns are labels that repeat.
         if all(_plain_text(x) for x in column[~missing].unique()):
