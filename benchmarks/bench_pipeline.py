@@ -22,6 +22,12 @@ Then it **restyles one figure**: a line is added to the copy's
 newer modification time alone) and the ``snakemake`` call that follows is timed, with
 the jobs it reran. ``--fresh`` first rebuilds with the numba cache empty, as a fresh
 clone does, then rebuilds again with the cache it filled.
+
+``--imports`` finally rebuilds once more on one core with ``PYTHONPROFILEIMPORTTIME``
+(``python -X importtime`` for every job) and prints, per rule, the seconds its jobs
+spent importing modules, and how much of it went to the heavy packages (cumulative:
+a package's figure includes what it was first to load, so scipy.signal includes
+scipy.stats). Import timing slows imports a little; read the shares.
 """
 
 from __future__ import annotations
@@ -150,6 +156,48 @@ def restyle(work: Path, cores: int, extra: list[str]) -> tuple[float, list[str]]
     return elapsed, ran
 
 
+#: Packages whose import cost --imports shows per rule.
+HEAVY_IMPORTS = ("snakemake", "pandas", "numba", "matplotlib.figure", "scipy.signal",
+                 "scipy.stats", "scipy.optimize", "scipy.interpolate")  # fmt: skip
+
+_RULE_LINE = re.compile(r"^\s*(?:local)?rule (\w+):")
+_IMPORT_LINE = re.compile(r"^import time:\s+\d+ \|\s+(\d+) \|( *)(\S+)$")
+
+
+def import_table(work: Path, extra: list[str]) -> pd.DataFrame:
+    """Per rule: jobs, seconds of imports (top-level, summed), seconds per heavy package.
+
+    A forced rebuild on one core, so that each job's import report follows the
+    ``rule <name>:`` line Snakemake writes before it."""
+    env_name = "PYTHONPROFILEIMPORTTIME"
+    os.environ[env_name] = "1"
+    try:
+        _, done = snakemake(["--cores", "1", "--forceall", *extra], work)
+    finally:
+        del os.environ[env_name]
+    rows: dict[str, dict] = {}
+    rule = "(snakemake itself)"
+    for line in done.stderr.splitlines():
+        header = _RULE_LINE.match(line)
+        if header:
+            rule = header.group(1)
+            row = rows.setdefault(rule, {"rule": rule, "jobs": 0, "imports_s": 0.0})
+            row["jobs"] += 1
+            continue
+        timing = _IMPORT_LINE.match(line)
+        if not timing:
+            continue
+        seconds, indent, module = int(timing.group(1)) / 1e6, timing.group(2), timing.group(3)
+        row = rows.setdefault(rule, {"rule": rule, "jobs": 0, "imports_s": 0.0})
+        if indent == " ":  # top level: "| name" (one space after the bar)
+            row["imports_s"] += seconds
+        if module in HEAVY_IMPORTS:
+            row[module] = row.get(module, 0.0) + seconds
+    table = pd.DataFrame(list(rows.values())).fillna(0.0)
+    columns = ["rule", "jobs", "imports_s", *[m for m in HEAVY_IMPORTS if m in table]]
+    return table[columns].sort_values("imports_s", ascending=False)
+
+
 def report(args, timings: dict, jobs: pd.DataFrame, phases: pd.DataFrame) -> None:
     """Print the figures of one benchmark run."""
     per_rule = (
@@ -191,6 +239,9 @@ def main(argv=None) -> int:
     parser.add_argument("--keep", type=Path, help="work here and keep the results")
     parser.add_argument("--json", type=Path, help="also write the timings here")
     parser.add_argument("--fresh", action="store_true", help="also rebuild, numba cache empty")
+    parser.add_argument(
+        "--imports", action="store_true", help="also: import time per rule (one-core rebuild)"
+    )
     args = parser.parse_args(argv)
 
     configfiles = [path.resolve() for path in args.configfile]
@@ -213,10 +264,18 @@ def main(argv=None) -> int:
         timings["restyle_s"], timings["restyle_rules"] = restyle(work, args.cores, extra)
         again = benchmark_table(out)
         timings["restyle_job_s"] = float(again.loc[again["rule"] == RESTYLED[1], "wall_s"].iloc[0])
+        imports = import_table(work, extra) if args.imports else None
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
     report(args, timings, jobs, phases)
+    if imports is not None:
+        jobs_only = imports[imports["jobs"] > 0]
+        print("\nimports per rule (one-core rebuild, PYTHONPROFILEIMPORTTIME), s:")
+        print(imports.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+        print(f"all jobs: {jobs_only['imports_s'].sum():.1f} s of imports in "
+              f"{int(jobs_only['jobs'].sum())} jobs")  # fmt: skip
+        timings["imports"] = imports.to_dict("records")
     if args.json:
         timings |= {"jobs": jobs.to_dict("records"), "simulate_phases": phases.to_dict("records")}
         args.json.write_text(json.dumps(timings, indent=2, sort_keys=True) + "\n")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from chain.analysis.ssw_track import ssw_speed_table, ssw_track_table
 from chain.physics.materials import STEEL_100C6
@@ -102,3 +104,46 @@ def test_paper_chains_even_separates_odd_does_not():
     np.testing.assert_allclose(
         rstw.loc[26 - lstw.index, "force_N"].to_numpy(), lstw["force_N"].to_numpy(), rtol=1e-9
     )
+
+
+def scipy_first_bump(signal, main_index, window_s, floor_N, time):
+    """The scipy.signal.find_peaks formulation _first_bump replaces."""
+    from scipy.signal import find_peaks
+
+    peaks, _ = find_peaks(signal[main_index:], height=floor_N, prominence=floor_N)
+    peaks = peaks[time[main_index + peaks] - time[main_index] <= window_s]
+    return int(main_index + peaks[0]) if peaks.size else -1
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(st.integers(0, 6), min_size=1, max_size=60),
+    st.integers(0, 59),
+    st.floats(0.0, 70.0),
+    st.floats(0.0, 4.0),
+)
+def test_first_bump_is_the_first_peak_find_peaks_gives(levels, main, window, floor):
+    # Small integer levels: plateaus, equal neighbours and ties of every kind.
+    from chain.analysis.ssw_track import _first_bump
+
+    signal = np.asarray(levels, dtype=float) * 0.5
+    time = np.arange(signal.size) * 1.0
+    main = min(main, signal.size - 1)
+    expected = scipy_first_bump(signal, main, window, floor, time)
+    assert _first_bump(signal, main, window, floor, time) == expected
+
+
+def test_first_bump_on_contact_forces_agrees_with_find_peaks():
+    from chain.analysis.ssw_track import _first_bump
+
+    model = uniform_chain(26, STEEL_100C6, 4.76e-3, 0.0)
+    result = simulate(model, [0.3], [0.3], duration=1.5e-3, record_interval=1e-6)
+    force, time = result.contact_force[0], result.time
+    rng = np.random.default_rng(3)
+    for k in range(force.shape[1]):
+        noisy = force[:, k] + rng.normal(0, 1e-3 * force.max(), force.shape[0])
+        for signal in (force[:, k], noisy):
+            main = int(np.argmax(signal))
+            for floor in (1e-4, 1e-3, 1e-2, 0.05):
+                args = (signal, main, 4e-4, floor * signal.max(), time)
+                assert _first_bump(*args) == scipy_first_bump(*args)
