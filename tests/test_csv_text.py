@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chain.atomic import write_csv_atomic
-from chain.csv_text import FLOAT_FORMAT, csv_text
+from chain.csv_text import FLOAT_FORMAT, ROWS_PER_CHUNK, csv_chunks, csv_text
 
 
 def pandas_text(table: pd.DataFrame) -> str:
@@ -95,3 +95,11 @@ def test_write_csv_atomic_writes_the_text(tmp_path):
     table = TABLES["trace-like"]()
     write_csv_atomic(table, tmp_path / "t.csv")
     assert (tmp_path / "t.csv").read_bytes() == pandas_text(table).encode()
+
+
+def test_chunks_of_a_long_table_join_to_pandas_bytes():
+    rows = 2 * ROWS_PER_CHUNK + 1
+    table = pd.DataFrame({"shot": np.arange(rows) % 7, "t_s": np.arange(rows) * 1e-6})
+    chunks = list(csv_chunks(table))
+    assert len(chunks) == 4  # the header, then three pieces of rows
+    assert "".join(chunks) == pandas_text(table)

@@ -468,16 +468,17 @@ def test_a_failing_table_write_leaves_no_file(tmp_path):
 
 
 def test_a_write_failing_midway_keeps_the_previous_file(tmp_path, monkeypatch):
-    """to_csv raising after half the rows are out: the old file stays as it was."""
+    """The CSV text failing after the first rows are out: the old file stays as it was."""
+    import chain.csv_text
+
     target = tmp_path / "table.csv"
     target.write_text("old,content\n")
 
-    def half_then_fail(self, stream, **kwargs):
-        stream.write("a,b\n1,2\n")
-        stream.flush()
+    def half_then_fail(table):
+        yield "a,b\n1,2\n"
         raise OSError("disk full")
 
-    monkeypatch.setattr(pd.DataFrame, "to_csv", half_then_fail)
+    monkeypatch.setattr(chain.csv_text, "csv_chunks", half_then_fail)
     with pytest.raises(OSError, match="disk full"):
         write_csv_atomic(pd.DataFrame({"a": [1], "b": [2]}), target)
     assert listing(tmp_path) == ["table.csv"]
@@ -542,18 +543,18 @@ TERMINATED_JOB = textwrap.dedent(
     import os, signal, sys, types
     import pandas as pd
     sys.path.insert(0, sys.argv[1])
+    import chain.csv_text
     from chain.atomic import write_csv_atomic
     folder = sys.argv[2]
     if sys.argv[3] == "start":
         import _logging
         _logging.start(types.SimpleNamespace(
             log=[os.path.join(folder, "job.log")], rule="demo", input=[], output=[]))
-    def to_csv(self, stream, **kwargs):
-        stream.write("a,b\\n")
-        stream.flush()
+    def chunks(table):
+        yield "a,b\\n"
         os.kill(os.getpid(), signal.SIGTERM)
-        stream.write("1,2\\n")
-    pd.DataFrame.to_csv = to_csv
+        yield "1,2\\n"
+    chain.csv_text.csv_chunks = chunks
     write_csv_atomic(pd.DataFrame({"a": [1], "b": [2]}), os.path.join(folder, "t.csv"))
     """
 )

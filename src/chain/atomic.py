@@ -89,9 +89,13 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     path : path
         Destination; parent folders are created.
     """
-    from chain.csv_text import csv_text  # here: it imports pandas, which a table has loaded
+    from chain.csv_text import csv_chunks  # here: it imports pandas, which a table has loaded
 
-    write_text_atomic(csv_text(table), path)
+    with (
+        atomic_output(path) as temporary,
+        open(temporary, "w", encoding="utf-8", newline="") as stream,
+    ):
+        stream.writelines(csv_chunks(table))
 
 
 def replace_folder(staging: Path, out: Path) -> None:

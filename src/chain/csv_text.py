@@ -11,6 +11,9 @@ which path wrote them (``tests/test_csv_text.py`` compares the two).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from itertools import islice
+
 import numpy as np
 import pandas as pd
 
@@ -19,6 +22,10 @@ FLOAT_FORMAT = "%.10g"
 
 #: Characters that make pandas (the csv module, QUOTE_MINIMAL) quote a text field.
 _QUOTED = (",", '"', "\n", "\r")
+
+
+#: Rows per chunk of :func:`csv_chunks`.
+ROWS_PER_CHUNK = 10_000
 
 
 def csv_text(table: pd.DataFrame) -> str:
@@ -31,14 +38,29 @@ def csv_text(table: pd.DataFrame) -> str:
     table : DataFrame
         Any table; one with values this module does not format is passed to pandas.
     """
+    return "".join(csv_chunks(table))
+
+
+def csv_chunks(table: pd.DataFrame) -> Iterator[str]:
+    """:func:`csv_text` in pieces of up to :data:`ROWS_PER_CHUNK` rows (the header first),
+    for writing to a file as they come.
+
+    Parameters
+    ----------
+    table : DataFrame
+        Any table.
+    """
     names = list(table.columns)
     columns = None
     if len(names) > 1 and all(_plain_text(name) for name in names):
         columns = [_column_text(table.iloc[:, i]) for i in range(len(names))]
     if columns is None or any(column is None for column in columns):
-        return table.to_csv(index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
-    lines = [",".join(names), *map(",".join, zip(*columns))]
-    return "\n".join(lines) + "\n"
+        yield table.to_csv(index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
+        return
+    yield ",".join(names) + "\n"
+    rows = map(",".join, zip(*columns))
+    while chunk := list(islice(rows, ROWS_PER_CHUNK)):
+        yield "\n".join(chunk) + "\n"
 
 
 def _column_text(column: pd.Series) -> list[str] | None:
