@@ -3,7 +3,7 @@
 ``DataFrame.to_csv`` with a ``float_format`` formats every float through a generic
 per-cell path: 1 s for a 5 MB trace table, a quarter of a simulation job. The same
 text is built here from whole columns (Python's ``%`` on a list of floats, then one
-join per row), 5-8x faster. Tables this module does not handle exactly as pandas
+join per row), 3-5x faster. Tables this module does not handle exactly as pandas
 does (text that would need quoting, a single column, dtypes other than float, int,
 bool and plain text) are written by pandas itself, so the bytes never depend on
 which path wrote them (``tests/test_csv_text.py`` compares the two).
@@ -22,7 +22,6 @@ FLOAT_FORMAT = "%.10g"
 
 #: Characters that make pandas (the csv module, QUOTE_MINIMAL) quote a text field.
 _QUOTED = (",", '"', "\n", "\r")
-
 
 #: Rows per chunk of :func:`csv_chunks`.
 ROWS_PER_CHUNK = 10_000
