@@ -36,19 +36,7 @@ ALLOWED = {
     "report": BOTTOM
     | {"chain.report", "chain.analysis", "chain.physics.theory", "chain.physics.materials"},
     "pipeline": BOTTOM | {"chain.pipeline", "chain.physics", "chain.apparatus", "chain.analysis"},
-    "cli": {
-        "chain",
-        "chain._lazy",
-        "chain.errors",
-        "chain.atomic",
-        "chain.csv_text",
-        "chain.traces",
-        "chain.labels",
-        "chain.physics",
-        "chain.apparatus",
-        "chain.analysis",
-        "chain.pipeline",
-    },
+    "cli": BOTTOM | {"chain.physics", "chain.apparatus", "chain.analysis", "chain.pipeline"},
 }
 
 #: Wing -> third-party packages it must not import.
