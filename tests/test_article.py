@@ -27,6 +27,7 @@ from matplotlib.figure import Figure
 from chain.pipeline.headline import headline_numbers
 from chain.report.article import CAPTIONS, article_numbers, compile_article
 from chain.report.article_figures import PARAGRAPHS
+from chain.report.article_tables import ablation_tables, c_spread_tables
 from chain.report.claims import NOT_COMPUTED, TOLERANCES, claims
 from chain.report.printed import plus_minus
 
@@ -322,3 +323,28 @@ def test_provenance_is_printed(tmp_path, figures):
     text = re.sub(r"\s+", " ", raw_text(tmp_path / "article.pdf"))
     assert "0123456789ab with uncommitted changes" in text
     assert "2026-01-02" in text and "fedcba987654" in text and "numpy 9.9.9" in text
+
+
+def test_long_tables_keep_pooled_rows_in_the_body_and_every_row_in_the_appendix():
+    rows = [
+        {"choice": "eta_us", "value": v, "N": n, "C": c, "C_stderr": 0.0523,
+         "exponent": -0.1516, "exponent_stderr": 0.0033, "n_points": 24, "headline": v == 0.58,
+         "note": "no usable delay on N = 26" if n == "pooled" and v == 1.16 else None}
+        for v in (0.0, 0.58, 1.16) for n, c in ((25, 44.6), (26, None), ("pooled", 43.21))
+    ]  # fmt: skip
+    tables = c_spread_tables(rows)
+    body, appendix = tables["body"], tables["appendix"]
+    assert len(body["rows"]) == 3 and len(appendix["rows"]) == 9
+    assert all(len(r) == len(body["columns"]) for r in body["rows"])
+    assert "C (µs N^1/6)" in body["columns"]  # the unit in the header
+    assert body["rows"][0][1] == "43.21 ± 0.05"  # one rule: chain.report.printed
+    assert body["rows"][1][0] == "η = 0.58 µs (headline)"
+    assert body["rows"][2][0].endswith("(no usable delay on N = 26)")
+    assert appendix["rows"][1][2] == "—"  # a chain without a fit, not "n/a" or "nan"
+    ablation = ablation_tables(
+        [{"variant": "no_imperfections", "N": "pooled", "C": 42.6, "C_stderr": 0.15,
+          "exponent": -0.154, "exponent_stderr": 0.005, "n_points": 96,
+          "overrides": "noise_N=0.0; adc_bits=None"}]
+    )  # fmt: skip
+    assert ablation["body"]["rows"][0][:2] == ["no imperfections", "noise_N = 0.0; adc_bits = None"]
+    assert c_spread_tables([]) is None and ablation_tables(None) is None

@@ -11,6 +11,7 @@ entry in :data:`FIGURE_SECTIONS` and :data:`CAPTIONS` (and a paragraph function 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 
 from chain.report.claims import series_label
@@ -37,14 +38,14 @@ CAPTIONS = {
     "beads S1 and S2, and the left- and right-travelling waves (LSTW, RSTW).",
     "fig2_experiment_traces": "Force at the two sensors in the experiment series of this "
     "run, one column per chain: the left-launched wave solid, the right-launched dashed, "
-    "a reference wave that crossed nothing dotted. The crossed waves arrive before the "
-    "reference.",
+    "a reference wave that crossed nothing dotted: compare the arrival of the crossed "
+    "waves with the reference's.",
     "fig3_simulation_traces": "The same from the simulation of Eq. 1, force felt by the "
     "sensor beads (sensors not modelled), with the SSW marked where it is found.",
     "fig4_delay_vs_force": "|Δ| against the incident amplitude F_m at the first sensor, "
     "log-log: simulations, experiment series, the fits C F_m^(−1/6), the two ballistic "
-    "estimates, and the paper's C_exp quoted. The points fall on lines of slope −1/6 "
-    "between the two ballistic lines.",
+    "estimates, and the paper's C_exp quoted; a line of slope −1/6 is the scaling the "
+    "paper claims.",
     "fig5_ssw_vs_force": "Amplitude of the secondary solitary wave against the incident "
     "amplitude, per series and chain; a line of slope 1 is an SSW proportional to F_m.",
     "ssw_spacetime": "Contact force over contact index and time for one collision in an "
@@ -76,11 +77,13 @@ def _pooled_c(summary: Mapping) -> str:
 
 
 def _slopes(summary: Mapping) -> str:
-    """'simulation, elastic, N = 25: 0.0123 ± 0.0004; ...' of the SSW fits."""
+    """'simulation, elastic, N = 25: 0.0123 ± 0.0004; ...' of the SSW fits that gave a
+    slope ('' for none)."""
     return "; ".join(
         f"{series_label(summary, r['source'], r['model'])}, N = {r['N']}: "
         f"{plus_minus(r.get('slope'), r.get('slope_stderr'))}"
         for r in summary.get("ssw_fits") or []
+        if r.get("slope") is not None and math.isfinite(float(r["slope"]))
     )
 
 
@@ -104,9 +107,9 @@ def _numbers_spread(summary: Mapping) -> str | None:
     )
 
 
-def _numbers_slopes(summary: Mapping) -> str | None:
+def _numbers_slopes(summary: Mapping) -> str:
     slopes = _slopes(summary)
-    return f"Slopes SSW / F_m: {slopes}." if slopes else None
+    return f"Fitted slopes SSW / F_m: {slopes}." if slopes else "No series gave a slope."
 
 
 def _numbers_drift(summary: Mapping) -> str | None:
@@ -140,7 +143,8 @@ def _paragraph_sensitivity(summary: Mapping) -> str:
     if not ranges:
         return "shows how C moves when one choice of the analysis changes."
     widths = sorted(((max(v) - min(v), k) for k, v in ranges.items()), reverse=True)
-    moves = ", ".join(f"{k.replace('_us', '')} by {w:.1f}" for w, k in widths)
+    names = {"eta_us": "η", "amplitudes": "the amplitude range", "sensors": "the sensor pair"}
+    moves = ", ".join(f"{names.get(k, k)} by {w:.1f}" for w, k in widths)
     return (
         "sets the choices side by side. Changed one at a time, they move the pooled C "
         f"({UNITS_C}) as follows: {moves}; over all choices C spans "
@@ -175,6 +179,21 @@ def _paragraph_slopes(summary: Mapping) -> str:
     )
 
 
+def _paragraph_ssw(summary: Mapping) -> str:
+    rows = summary.get("ssw_fits") or []
+    slopes = _slopes(summary)
+    if slopes:
+        return (
+            "sets the SSW amplitude against the incident amplitude for every series and "
+            f"chain; where the SSW is resolved, the fitted slopes SSW / F_m are {slopes}."
+        )
+    return (
+        "sets the SSW amplitude against the incident amplitude for every series and "
+        f"chain. In this run none of the {len(rows)} series resolved an SSW at its "
+        "sensors: the figure says so, and no slope is fitted."
+    )
+
+
 def _paragraph_mechanisms(summary: Mapping) -> str:
     return (
         "compares the SSW of each candidate mechanism for the paper's excess SSW "
@@ -191,6 +210,7 @@ PARAGRAPHS: dict[str, Callable[[Mapping], str]] = {
         "the ballistic picture expects the same C for every chain long enough for the waves "
         "to have formed before they meet."
     ),
+    "fig5_ssw_vs_force": _paragraph_ssw,
     "ssw_spacetime": _paragraph_spacetime,
     "fig_parity_ssw_vs_N": _paragraph_slopes,
     "fig_ssw_mechanisms": _paragraph_mechanisms,

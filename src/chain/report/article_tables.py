@@ -34,12 +34,19 @@ def choice_name(row: Mapping) -> str:
 
 
 def _fit_cells(row: Mapping) -> list[str]:
-    """C ± stderr, p ± stderr and the number of points of one fit row."""
-    return [
+    """C ± stderr, p ± stderr and the number of points of one fit row ("—" for a fit
+    that was not possible)."""
+    cells = [
         plus_minus(row.get("C"), row.get("C_stderr")),
         plus_minus(row.get("exponent"), row.get("exponent_stderr")),
-        str(row.get("n_points", "")),
     ]
+    return [c.replace("n/a", "—") for c in cells] + [str(row.get("n_points", ""))]
+
+
+def _with_note(row: Mapping) -> str:
+    """The choice's name, with its note (a chain missing from the pooled fit)."""
+    note = row.get("note")
+    return f"{choice_name(row)} ({note})" if note else choice_name(row)
 
 
 def _pooled(rows: Sequence[Mapping]) -> list[Mapping]:
@@ -58,7 +65,7 @@ def c_spread_tables(rows: Sequence[Mapping] | None) -> dict | None:
     """
     if not rows:
         return None
-    body = [[choice_name(r), *_fit_cells(r)] for r in _pooled(rows)]
+    body = [[_with_note(r), *_fit_cells(r)] for r in _pooled(rows)]
     appendix = [
         [choice_name(r), str(r.get("N")), *_fit_cells(r), r.get("note") or ""] for r in rows
     ]
