@@ -333,18 +333,20 @@ def article_numbers(
 
 
 def provenance_text(provenance: Mapping | None) -> dict:
-    """The colophon's lines: commit (with "uncommitted changes" when dirty), date,
-    config hash and package versions, as printed."""
+    """The provenance as printed: ``source`` ('commit 0123456789ab, committed 2026-01-02',
+    with 'with uncommitted changes' when the tree was dirty, or why there is no commit),
+    ``config_hash`` and ``versions`` ('numpy 2.4.6, ...')."""
     if not provenance:
-        return {"commit": "not recorded", "date": "not recorded", "config_hash": "not recorded",
+        return {"source": "an unrecorded checkout", "config_hash": "not recorded",
                 "versions": "not recorded"}  # fmt: skip
-    commit = str(provenance.get("commit"))
-    if provenance.get("dirty"):
-        commit += " with uncommitted changes"
+    if provenance.get("date") is None:
+        source = f"a copy of the workflow that is {provenance.get('commit')} (no commit date)"
+    else:
+        dirty = " with uncommitted changes" if provenance.get("dirty") else ""
+        source = f"commit {provenance['commit']}{dirty}, committed {provenance['date']}"
     versions = provenance.get("versions") or {}
     return {
-        "commit": commit,
-        "date": provenance.get("date") or "no commit date",
+        "source": source,
         "config_hash": str(provenance.get("config_hash")),
         "versions": ", ".join(f"{k} {v}" for k, v in versions.items()) or "not recorded",
     }
