@@ -117,8 +117,33 @@ def _numbers_drift(summary: Mapping) -> str | None:
     return None if drift is None else f"Largest relative energy drift {drift:.1e}."
 
 
+def _numbers_chains(summary: Mapping) -> str | None:
+    chains = sorted({int(r["N"]) for r in summary.get("delay_fits") or [] if r["N"] != "pooled"})
+    return f"Chains of N = {', '.join(map(str, chains))} beads." if chains else None
+
+
+def _numbers_selection(summary: Mapping) -> str | None:
+    """'Kept by the acceptance rule: N = 25, 17 of 24 collisions; ...'."""
+    parts = [
+        f"N = {c['N']}, {c['kept']} of {c['kept'] + c['rejected']} {c['kind']}s"
+        for c in summary.get("selection") or []
+        if c.get("kind") == "collision"
+    ]
+    return f"Kept by the acceptance rule: {'; '.join(parts)}." if parts else None
+
+
+def _numbers_separation(summary: Mapping) -> str | None:
+    rows = summary.get("ssw_separation") or []
+    shots = sum(int(r.get("n_shots") or 0) for r in rows)
+    separated = sum(int(r.get("n_shots_separated") or 0) for r in rows)
+    return f"The SSW separated in {separated} of {shots} tracked waves." if shots else None
+
+
 #: Numbers each caption adds, from summary.json (None: the caption alone).
 _CAPTION_NUMBERS: dict[str, Callable[[Mapping], str | None]] = {
+    "fig1_setup": _numbers_chains,
+    "fig2_experiment_traces": _numbers_selection,
+    "ssw_spacetime": _numbers_separation,
     "fig3_simulation_traces": _numbers_drift,
     "fig4_delay_vs_force": _numbers_fig4,
     "fig5_ssw_vs_force": _numbers_slopes,
