@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
 from chain.report import picks
+from chain.report.printed import plus_minus
 from chain.report.style import (
     STYLE,
     add_legend,
@@ -65,7 +66,7 @@ def fig5_ssw_vs_force(
                 label += f": SSW not resolved (0 of {len(shots)})"
             slope = slopes.get((source, model, int(n)))
             if not group.empty and slope is not None and np.isfinite(slope[0]):
-                label += f" (slope {slope[0]:.2e} ± {slope[1]:.1e})"
+                label += f" (slope {plus_minus(*slope, style='mathtext')})"
                 grid = np.geomspace(group["F_m_N"].min(), group["F_m_N"].max(), 20)
                 ax.plot(grid, slope[0] * grid, color=style["color"], lw=0.7, ls="-", alpha=0.7)
             ax.plot(group["F_m_N"], group["ssw_N"], ls="none", ms=4.5, label=label, **style)

@@ -19,6 +19,7 @@ from chain.analysis.selection import SKIPPED_REASON
 from chain.atomic import write_text_atomic
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
 from chain.report.paper import PAPER_ENERGY_DRIFT
+from chain.report.printed import plus_minus
 from chain.report.spread import spread_markdown_rows
 
 #: A row of the table: quantity, paper, this run, note.
@@ -327,14 +328,9 @@ def _percent(value: float, reference: float) -> str:
 
 
 def _pm(value, error, digits=2) -> str:
-    """``value ± error`` with the error to two significant digits (at least ``digits``
-    decimals), or ``n/a``."""
-    if value is None:
-        return "n/a"
-    if error is None or not error > 0:
-        return f"{value:.{digits}f}"
-    decimals = min(8, max(digits, 1 - math.floor(math.log10(error))))
-    return f"{value:.{decimals}f} ± {error:.{decimals}f}"
+    """``value ± error`` by the one rule of :func:`chain.report.printed.plus_minus`
+    (``digits`` decimals when there is no error), or ``n/a``."""
+    return plus_minus(value, error, digits, style="unicode")
 
 
 def _who(row: Mapping, experiment_label: str = "experiment") -> str:
