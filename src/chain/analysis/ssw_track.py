@@ -15,9 +15,16 @@ end it runs to. At every contact downstream of the collision point:
    (TRACK_FLOOR^(-1/6) - 1) beads' worth of the main pulse's transit time (d the
    distance from the collision point, Eq. 5's F^(1/6) speed law). The small waves that
    trail each pulse from its launch (born a whole half chain upstream) lag far more.
-4. **Moving in the same direction.** A maximum counts (``separated``) only if it
-   links to one at a neighbouring contact: arriving later at the downstream contact, by
-   no more than :data:`MAX_STEP_RATIO` main-pulse transit times.
+4. **Moving like a solitary wave of its size.** Maxima at neighbouring contacts link
+   when the downstream one arrives later by a transit time within a factor
+   :data:`SPEED_FACTOR` of Eq. 5's for its own amplitude: the main pulse's transit time
+   x (SSW / main pulse)^(-1/6) (the F^(1/6) speed law; no material needed).
+5. **Persisting.** A maximum is ``separated`` only as part of a run of at least
+   :data:`MIN_RUN` linked contacts, the fewest that show a speed. This is the one
+   definition of "separated", for every model and N: a bump seen at two contacts only
+   (e.g. the gap that opens and closes behind the crossed pulse with Kuwabara-Kono
+   dissipation, moving at half the speed a wave of its size would) is not an SSW, and
+   a smooth tail (Kuwabara-Kono's) has no maximum at all.
 
 A separated SSW is **detached** where the force between it and the crossed pulse (the
 trailing minimum) has fallen below the floor: until then it rides on the crossed
@@ -47,8 +54,13 @@ TRACK_FLOOR = 1e-3
 #: Width of the birth region around the collision point, beads (window of rule 3).
 BIRTH_BEADS = 2.0
 
-#: Largest SSW transit time between neighbouring contacts, in main-pulse transit times.
-MAX_STEP_RATIO = 1.5 * TRACK_FLOOR ** (-1.0 / 6.0)
+#: A link's transit time may differ from Eq. 5's for the SSW's own amplitude by this
+#: factor either way (a wave still riding on the crossed pulse's tail is pulled along,
+#: up to ~10 % faster; one slowing down where the chain ahead unloads, slower).
+SPEED_FACTOR = 2.0
+
+#: Fewest linked contacts of a separated SSW (two intervals: a speed).
+MIN_RUN = 3
 
 #: Fewest separated contacts for a speed fit (two intervals).
 MIN_SPEED_CONTACTS = 3
@@ -162,7 +174,8 @@ def track_wave(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict:
     trough = np.array(
         [force[m:i, k - 1].min() if i >= 0 else math.nan for m, i, k in zip(main, found, contacts)]
     )
-    separated = _linked(ssw_time, step)
+    main_force = force[main, contacts - 1]
+    separated = _linked(ssw_time, ssw_force / main_force, step)
     return {
         "contact": contacts,
         "time_s": ssw_time,
@@ -171,7 +184,7 @@ def track_wave(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict:
         "detached": separated & (trough <= floor * f_m),
         "trailing_min_N": trough,
         "main_time_s": time[main],
-        "main_force_N": force[main, contacts - 1],
+        "main_force_N": main_force,
         "other_time_s": np.array(
             [time[np.argmax(np.where(before, force[:, k - 1], -np.inf))] for k in contacts]
         ),
@@ -226,16 +239,35 @@ def _prominence(x: np.ndarray, peak: int) -> float:
     return top - max(x[left : peak + 1].min(), x[peak:right].min())
 
 
-def _linked(ssw_time, step: float) -> np.ndarray:
-    """True where an SSW maximum links to one at a neighbouring contact: later
-    downstream, by at most MAX_STEP_RATIO main-pulse steps (same direction of travel)."""
+def _linked(ssw_time, relative_force, step: float) -> np.ndarray:
+    """True where an SSW maximum is part of a run of at least MIN_RUN linked contacts.
+
+    Neighbours link when the downstream maximum is later by Eq. 5's transit time for the
+    SSW's size, ``step`` x (SSW / main pulse)^(-1/6), within a factor SPEED_FACTOR.
+
+    Parameters
+    ----------
+    ssw_time : array
+        Time of the SSW maximum per contact, outward, s (NaN where none).
+    relative_force : array
+        SSW maximum over the crossed pulse's peak at the same contact.
+    step : float
+        The crossed pulse's transit time between neighbouring contacts, s.
+    """
     gaps = np.diff(ssw_time)
-    with np.errstate(invalid="ignore"):
-        link = (gaps > 0) & (gaps <= MAX_STEP_RATIO * step)
-    linked = np.zeros(ssw_time.size, dtype=bool)
-    linked[:-1] |= link
-    linked[1:] |= link
-    return linked
+    with np.errstate(invalid="ignore", divide="ignore"):
+        size = 0.5 * (relative_force[1:] + relative_force[:-1])
+        expected = step * size ** (-1.0 / 6.0)
+        link = (gaps > expected / SPEED_FACTOR) & (gaps < expected * SPEED_FACTOR)
+    separated = np.zeros(ssw_time.size, dtype=bool)
+    start = 0
+    # Runs of consecutive links: contacts start..end joined by end - start links.
+    for end in range(link.size + 1):
+        if end == link.size or not link[end]:
+            if end - start + 1 >= MIN_RUN:
+                separated[start : end + 1] = True
+            start = end + 1
+    return separated
 
 
 def track_collision(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict[str, dict]:
