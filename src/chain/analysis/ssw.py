@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from chain.analysis.pulses import estimate_baseline
-from chain.analysis.regression import fit_proportional
+from chain.analysis.regression import fit_proportional, ratio_with_error
 from chain.analysis.rows import is_ok
 from chain.analysis.selection import apply_selection
 from chain.traces import iter_shots, sensor_beads
@@ -648,24 +648,3 @@ def ssw_parity_table(fits: pd.DataFrame, even: int = 26, odd: int = 25) -> pd.Da
                 )
             )
     return pd.DataFrame(rows, columns=["source", "model", "ratio", "ratio_err"])
-
-
-def ratio_with_error(top: float, top_err: float, bottom: float, bottom_err: float) -> dict:
-    """top / bottom and its error, the relative errors added in quadrature.
-
-    Parameters
-    ----------
-    top, top_err, bottom, bottom_err : float
-        The two numbers and their errors (same units each).
-
-    Returns
-    -------
-    dict
-        ``ratio`` and ``ratio_err`` (NaN where ``bottom`` is 0 or NaN).
-    """
-    top, top_err, bottom, bottom_err = map(float, (top, top_err, bottom, bottom_err))
-    if not bottom or not math.isfinite(bottom):
-        return {"ratio": math.nan, "ratio_err": math.nan}
-    ratio = top / bottom
-    relative = math.hypot(top_err / top if top else math.nan, bottom_err / bottom)
-    return {"ratio": ratio, "ratio_err": abs(ratio) * relative}

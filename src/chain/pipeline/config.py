@@ -230,7 +230,32 @@ def _check_chains(config: Mapping) -> dict[int, int]:
                 ["chains", i, "sensors"],
                 f"got {[s1, s2]}; allowed: S1 left of S2 (S1 < S2; S1 is met first by the LSTW)",
             )
+    for i, n in enumerate(config.get("long_chains", {}).get("N", [])):
+        if n in seen_n:
+            _fail(
+                ["long_chains", "N", i],
+                f"N = {n} is also chains[{seen_n[n]}] (their files would clash); allowed: "
+                "an N not in chains",
+            )
     return seen_n
+
+
+def long_chain_duration(config: Mapping, n_beads: int) -> float:
+    """Simulated time of a long chain, s: ``long_chains.duration_s``, or by default
+    ``simulation.duration_s`` x N / the largest N of ``chains``.
+
+    Parameters
+    ----------
+    config : mapping
+        A schema-valid config (defaults filled in).
+    n_beads : int
+        N of the long chain.
+    """
+    duration = config.get("long_chains", {}).get("duration_s")
+    if duration is not None:
+        return float(duration)
+    longest = max(entry["N"] for entry in config["chains"])
+    return float(config["simulation"]["duration_s"]) * n_beads / longest
 
 
 def _check_models_and_launch(config: Mapping) -> list[str]:
