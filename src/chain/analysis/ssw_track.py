@@ -30,7 +30,7 @@ A separated SSW is **detached** where the force between it and the crossed pulse
 trailing minimum) has fallen below the floor: until then it rides on the crossed
 pulse's tail and is pulled along (up to ~10 % faster than Eq. 5 in a 60-bead chain).
 The speed of the SSW is fitted on the detached contacts of its first run of separated
-contacts that it reaches before the main pulse reaches the last contact (afterwards the
+contacts that it reaches before the main pulse reaches the second-to-last contact (afterwards the
 end beads fly apart and the chain ahead of the SSW unloads; it slows down). Eq. 5 at the
 SSW's own mean amplitude over those contacts gives the speed a solitary wave of that
 size would have (:func:`ssw_speed_table` takes it as a function: this module knows no
@@ -390,7 +390,7 @@ def shot_speed(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> di
         ``speed_m_s``, ``eq5_speed_m_s``, ``force_N`` (mean SSW maximum over the fit),
         ``ratio`` (NaN below :data:`MIN_SPEED_CONTACTS` contacts), ``far_over_Fm`` (SSW /
         F_m at the last contact of its first separated run before the main pulse
-        reaches the last contact: the farthest it is seen undisturbed; detached or not,
+        reaches the second-to-last contact: the farthest it is seen undisturbed; detached or not,
         as with Kuwabara-Kono the tail between the two waves rarely empties) and
         ``far_change`` (how much SSW / F_m changed over the last MIN_SPEED_CONTACTS
         contacts: not yet settled by that much).
@@ -412,7 +412,7 @@ def shot_speed(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> di
 def _speed_run(track: pd.DataFrame) -> tuple[dict, pd.DataFrame, pd.DataFrame]:
     """Where the SSW separates and detaches; the contacts its speed is fitted on (the
     detached ones of its first run of separated contacts, before the main pulse reaches
-    the last contact); and that run's contacts before then, detached or not."""
+    the second-to-last contact); and that run's contacts before then, detached or not."""
     rows = track.sort_values("distance_beads")
     separated = rows["separated"].to_numpy(bool)
     result = {"first_separated_contact": None, "distance_beads": math.nan, "n_contacts": 0}
@@ -428,8 +428,9 @@ def _speed_run(track: pd.DataFrame) -> tuple[dict, pd.DataFrame, pd.DataFrame]:
     detached = run[run["detached"].to_numpy(bool)]
     if not detached.empty:
         result["first_detached_contact"] = int(detached["contact"].iloc[0])
-    # The chain ahead unloads once the main pulse has reached the last contact.
-    end = rows["main_time_us"].iloc[-1]
+    # The chain ahead unloads once the main pulse has reached the end; the last
+    # contact's own peak comes late (the end bead flies off), so the one before it.
+    end = rows["main_time_us"].iloc[-2] if len(rows) > 1 else rows["main_time_us"].iloc[-1]
     result["n_contacts"] = int((detached["time_us"] < end).sum())
     return result, detached[detached["time_us"] < end], run[run["time_us"] < end]
 

@@ -262,12 +262,17 @@ def _ssw_fit_rows(summary) -> dict:
     }
 
 
+def _stat(fit) -> float:
+    """A fit's statistical error (its total error in tables without the split)."""
+    return fit.get("slope_stat", fit.get("slope_stderr"))
+
+
 def _pct(fit) -> str:
     """'(3.43 ± 0.00 stat ± 2.07 sys) % of F_m'."""
-    return (
-        f"({fixed(100 * fit['slope'], 2)} ± {fixed(100 * fit['slope_stat'], 2)} stat "
-        f"± {fixed(100 * fit['slope_sys'], 2)} sys) % of F_m"
-    )
+    text = f"({fixed(100 * fit['slope'], 2)} ± {fixed(100 * _stat(fit), 2)} stat"
+    if fit.get("slope_sys") is not None:
+        text += f" ± {fixed(100 * fit['slope_sys'], 2)} sys"
+    return text + ") % of F_m"
 
 
 def _proportional_claim(summary, source, model, group, fits) -> dict:
@@ -363,7 +368,7 @@ def _experiment_claim(summary, fits) -> list[dict]:
             if s_source != "simulation" or s_n != n:
                 continue
             stat = ratio_with_error(
-                fit["slope"], fit["slope_stat"], sim["slope"], sim["slope_stat"]
+                fit["slope"], _stat(fit), sim["slope"], _stat(sim)
             )
             total = ratio_with_error(
                 fit["slope"], fit["slope_stderr"], sim["slope"], sim["slope_stderr"]
