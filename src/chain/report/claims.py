@@ -367,9 +367,7 @@ def _experiment_claim(summary, fits) -> list[dict]:
         for (s_source, s_model, s_n), sim in sorted(fits.items(), key=str):
             if s_source != "simulation" or s_n != n:
                 continue
-            stat = ratio_with_error(
-                fit["slope"], _stat(fit), sim["slope"], _stat(sim)
-            )
+            stat = ratio_with_error(fit["slope"], _stat(fit), sim["slope"], _stat(sim))
             total = ratio_with_error(
                 fit["slope"], fit["slope_stderr"], sim["slope"], sim["slope_stderr"]
             )
