@@ -47,6 +47,18 @@ NOTES = [
     "and N. Its far-field size comes from the long chains (config long_chains), at the "
     "farthest contact before the main pulse reaches the free end. Contact k joins beads "
     "k and k+1.",
+    "* What the SSW rows show, and why (paper run; tests/test_ssw_track.py, "
+    "docs/analysis.md): at the sensors the SSW is a shoulder, so its value is mostly the "
+    "template misfit and the even / odd ratio there is within 2 errors of 1; it is decided "
+    "far from the collision point. The elastic SSW's speed over Eq. 5 in the long chains, "
+    "fitted from where it detaches, is 1.020 (even) and 1.031 (odd); fitted only where it "
+    "has settled (20 beads on) both give 1.013, the main pulse's own ratio (Eq. 5 is a "
+    "long-wavelength approximation): the excess is the SSW still growing over the first "
+    "contacts (odd: 0.69 to 0.85 % of F_m). With Kuwabara-Kono dissipation no SSW "
+    "separates in the paper's chains, but one does in the long chains, decaying along "
+    "them and larger at larger F_m; the dissipative tail keeps the contact between it and "
+    "the crossed pulse loaded, so it rarely detaches before the free end and its speed is "
+    "mostly not measured.",
 ]
 
 
