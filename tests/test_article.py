@@ -241,3 +241,32 @@ def test_a_run_without_experiment_says_so(tmp_path, figures):
     assert "Thisrunhasnoexperimentside." in text
     assert "Thisrunhasnoexperimentseries." in text
     assert "virtualexperiment(model)" not in text
+
+
+def ssw_claim(summary, name) -> dict:
+    return next(row for row in claims(summary) if row["claim"] == name)
+
+
+def test_ssw_parity_and_experiment_claims_carry_their_numbers():
+    """Even > odd is decided by the ratios and their errors, never "not testable" when a
+    ratio exists; the virtual experiment (a model) is compared with the simulation."""
+    summary = copy.deepcopy(SUMMARY)
+    summary["ssw_far_field"] = copy.deepcopy(FINDINGS["ssw_far_field"])
+    parity = ssw_claim(summary, "SSW larger in even chains")
+    assert parity["agrees"] == "yes" and "3.53" in parity["ours"]
+    # The odd chain larger far from the collision point: refuted.
+    summary["ssw_far_field"][0].update(ratio=0.8, ratio_err=0.01)
+    assert ssw_claim(summary, "SSW larger in even chains")["agrees"] == "no"
+    # Everything within 2 errors of 1: a number, so "no" (not shown), not "not testable".
+    summary["ssw_far_field"] = []
+    for row in summary["ssw_fits"]:
+        row["slope_stderr"] = row["slope"]
+    parity = ssw_claim(summary, "SSW larger in even chains")
+    assert parity["agrees"] == "no" and parity["why"].startswith("not shown")
+    # No fits and no long chains: nothing to form a ratio from.
+    summary["ssw_fits"] = []
+    assert ssw_claim(summary, "SSW larger in even chains")["agrees"] == "not testable"
+    experiment = ssw_claim(SUMMARY, "Simulated SSW much smaller than measured")
+    # Fixture: virtual 0.0376 / viscoelastic 0.0417 at N = 25.
+    assert experiment["agrees"] == "no" and "0.90" in experiment["ours"]
+    assert experiment["why"].startswith("not reproduced by the model; see the mechanism study")

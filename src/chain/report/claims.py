@@ -339,10 +339,11 @@ def _parity_claim(summary, fits) -> list[dict]:
     if not parts:
         return [_claim("SSW larger in even chains", "larger, no ratio", NOT_COMPUTED, None,
                        "no SSW slope of an even and an odd chain, no long chains")]  # fmt: skip
-    ok = None if not any(decisive) and not any(wrong) else (any(decisive) and not any(wrong))
+    # A number exists, so never "not testable": within 2 errors of 1 is "not shown".
+    ok = any(decisive) and not any(wrong)
     why = "" if ok else "some series give the odd chain the larger SSW"
-    if ok is None:
-        why = "even / odd above 1 but within 2 errors everywhere: the systematic error decides"
+    if not ok and not any(wrong):
+        why = "not shown: even / odd above 1 but within 2 errors everywhere (template misfit)"
     elif ok and not all(decisive):
         why = (
             "decided far from the collision point; at the sensors within 2 errors (template misfit)"
