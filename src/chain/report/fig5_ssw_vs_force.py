@@ -194,7 +194,7 @@ def draw_ssw_vs_distance(ax, track: pd.DataFrame, speed=None, sensor_distances=N
     for (model, n), group in rows.groupby(["model", "N"], sort=True):
         separated = group[group["separated"].astype(bool)]
         marker = chain_marker(int(n), chains)
-        marker = "s" if marker == "x" else marker
+        marker = "D" if marker == "x" else marker  # "s" may be a long chain's
         label = f"{model}, N = {n}" + ("" if len(separated) else ": never separated")
         ax.plot(
             separated["distance_beads"], separated["force_N"] / separated["F_m_N"],
