@@ -69,22 +69,34 @@ def fit_rows(summary: Mapping) -> list[dict]:
 
 
 def ssw_slope_rows(summary: Mapping) -> list[dict]:
-    """Every row of ``ssw_fits``, printed: slope ± stderr (4 decimals), points."""
+    """Every row of ``ssw_fits``, printed: slope ± statistical ± systematic error (4
+    decimals; ± total where a table has no split), points (resolved)."""
     return [
         {
             "series": series_label(summary, r["source"], r["model"]),
             "N": str(r["N"]),
-            "slope": plus_minus(r.get("slope"), r.get("slope_stderr"), 4),
-            "points": str(r.get("n_points", "")),
+            "slope": _slope_text(r),
+            "points": str(r.get("n_points", ""))
+            + ("" if r.get("n_resolved") is None else f" ({r['n_resolved']} resolved)"),
         }
         for r in sorted(summary["ssw_fits"], key=lambda r: (r["source"], r["model"], str(r["N"])))
     ]
+
+
+def _slope_text(row: Mapping) -> str:
+    """'0.0343 ± < 0.0001 ± 0.0207' (slope ± stat ± sys), or slope ± stderr."""
+    if row.get("slope_sys") is None:
+        return plus_minus(row.get("slope"), row.get("slope_stderr"), 4)
+    return (
+        f"{plus_minus(row.get('slope'), row.get('slope_stat'), 4)} ± {fixed(row['slope_sys'], 4)}"
+    )
 
 
 def findings(summary: Mapping) -> dict:
     """The SSW, ablation and C-spread findings of the run, printed, or None each.
 
     Reads the summary keys ``ssw_resolved``, ``ssw_separation``, ``ssw_parity_ratio``,
+    ``ssw_far_field``,
     ``ablation`` ({verdict, rows}) and ``c_spread`` ({headline_choice, min_us_N16,
     max_us_N16, rows}); an absent or empty key gives None.
     """
@@ -101,6 +113,7 @@ def findings(summary: Mapping) -> dict:
         },
         "ssw_separation": table_of(summary.get("ssw_separation")),
         "ssw_parity_ratio": table_of(summary.get("ssw_parity_ratio")),
+        "ssw_far_field": table_of(summary.get("ssw_far_field")),
         "ablation": None
         if ablation is None
         else {

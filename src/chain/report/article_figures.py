@@ -46,11 +46,14 @@ CAPTIONS = {
     "log-log: simulations, experiment series, the fits C F_m^(−1/6), the two ballistic "
     "estimates, and the paper's C_exp quoted; a line of slope −1/6 is the scaling the "
     "paper claims.",
-    "fig5_ssw_vs_force": "Amplitude of the secondary solitary wave against the incident "
-    "amplitude, per series and chain; a line of slope 1 is an SSW proportional to F_m.",
+    "fig5_ssw_vs_force": "(a) Amplitude of the secondary solitary wave against the "
+    "incident amplitude at the sensors, per series and chain: error bars template misfit "
+    "and noise, filled resolved, arrows upper limits, lines the proportional fits. "
+    "(b) SSW / F_m against distance from the collision point where it has separated, "
+    "long chains included.",
     "ssw_spacetime": "Contact force over contact index and time for one collision in an "
-    "odd and an even chain (log colour scale), with the tracked waves; beside it, the SSW "
-    "amplitude against distance from the collision point.",
+    "odd and an even chain, the paper's and long ones (log colour scale), with the tracked "
+    "waves; beside it, the SSW amplitude against distance from the collision point.",
     "fig_parity_ssw_vs_N": "SSW slope against the number of beads, odd and even chains.",
     "fig_c_sensitivity": "C, chains pooled, for each choice of estimator, dissipation η, "
     "sensor pair and amplitude range, one choice changed at a time from the headline.",

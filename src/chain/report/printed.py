@@ -101,6 +101,28 @@ def plus_minus(value, error, decimals: int | None = None, style: str = "text") -
     return text if not _finite(error) else f"{text} ± 0"
 
 
+def plus_minus_stat_sys(value, stat, sys) -> str:
+    """``value ± stat (stat) ± sys (sys)``: decimals set by the total error
+    (:func:`error_decimals` of stat and sys in quadrature), the same for all three; an
+    error below the last decimal printed as ``< 0.0…1``. Plain text, no power of ten
+    (for values of order 1, such as percentages)."""
+    if not _finite(value):
+        return "n/a"
+    parts = [float(e) if _finite(e) else 0.0 for e in (stat, sys)]
+    total = math.hypot(*parts)
+    if total <= 0:
+        return plus_minus(value, None)
+    places = error_decimals(total)
+
+    def part(error: float, name: str) -> str:
+        if round(error, places) == 0:
+            return f"< {_decimal_text(10.0**-places, places)} ({name})"
+        return f"{_decimal_text(error, places)} ({name})"
+
+    value_text = _decimal_text(float(value), places)
+    return f"{value_text} ± {part(parts[0], 'stat')} ± {part(parts[1], 'sys')}"
+
+
 def _scaled(error, exponent: int):
     """``error`` / 10**exponent, None and NaN kept as they are."""
     return float(error) / 10.0**exponent if _finite(error) else error
