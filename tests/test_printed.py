@@ -72,3 +72,14 @@ def test_error_has_one_or_two_figures_and_the_value_its_decimal(value, error):
     assert abs(printed_error - error) <= 0.16 * error
     last = 10.0 ** -error_decimals(error)
     assert abs(printed_value - value) <= 0.5 * last + 1e-9 * abs(value)
+
+
+def test_value_with_a_statistical_and_a_systematic_error():
+    """Decimals set by the total error; an error below the last decimal says so."""
+    from chain.report.printed import plus_minus_stat_sys
+
+    assert plus_minus_stat_sys(5.0, 0.01, 0.20) == "5.00 ± 0.01 (stat) ± 0.20 (sys)"
+    assert plus_minus_stat_sys(3.43, 0.003, 2.07) == "3.4 ± < 0.1 (stat) ± 2.1 (sys)"
+    assert plus_minus_stat_sys(-1.81, 0.10, 1.61) == "\u22121.8 ± 0.1 (stat) ± 1.6 (sys)"
+    assert plus_minus_stat_sys(float("nan"), 0.1, 0.1) == "n/a"
+    assert plus_minus_stat_sys(2.5, None, None) == plus_minus(2.5, None)
