@@ -14,7 +14,7 @@ import math
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import partial
+from functools import lru_cache, partial
 
 import numba
 import numpy as np
@@ -293,16 +293,25 @@ def _report(batch: int):
     return tuple(np.zeros(batch, dtype=np.int64) for _ in range(3))
 
 
+@lru_cache(maxsize=256)
+def _contact_keys(n_links: int) -> np.ndarray:
+    """One fixed random 64-bit key per link and per wall (read-only), so that runs are
+    reproducible; drawn once per chain length (a quarter of a short run's set-up)."""
+    keys = np.random.default_rng(_KEY_SEED).integers(
+        0, np.iinfo(np.uint64).max, size=n_links + 2, dtype=np.uint64, endpoint=True
+    )
+    keys.flags.writeable = False
+    return keys
+
+
 def _lean_params(model: ChainModel) -> tuple:
     """The model as the flat arrays of :mod:`chain.physics.kernels` (see ``_slopes``)."""
     kind = np.ascontiguousarray(model.link_kind, dtype=np.int64)
     damping = 1.5 * model.link_eta * model.link_stiffness
     damping[kind == SPRING] = 0.0
     n_links = model.n_particles - 1
-    # One key per link and per wall, fixed, so that runs are reproducible.
-    keys = np.random.default_rng(_KEY_SEED).integers(
-        0, np.iinfo(np.uint64).max, size=n_links + 2, dtype=np.uint64, endpoint=True
-    )
+    # A copy: the kernels take writable arrays (a read-only one is another signature).
+    keys = _contact_keys(n_links).copy()
     springs = np.r_[np.flatnonzero(kind == SPRING), n_links].astype(np.int64)
     walls = np.stack([model.wall_stiffness, 1.5 * model.wall_eta * model.wall_stiffness], axis=1)
     drag = np.stack([model.drag_rate, model.masses * model.drag_rate], axis=1)

@@ -71,9 +71,9 @@ def default_time_step(model: ChainModel, max_launch_speed: float) -> float:
     moving = _moving_masses(model)
     hertz = np.flatnonzero(model.link_kind == HERTZ)
     # Linear in N: the Hertz time is computed once per distinct (m_a, m_b, kappa).
-    triples = np.unique(
-        np.stack([moving[hertz], moving[hertz + 1], model.link_stiffness[hertz]], axis=1), axis=0
-    )
+    triples = np.stack([moving[hertz], moving[hertz + 1], model.link_stiffness[hertz]], axis=1)
+    # A uniform chain has one triple: np.unique's sort is most of a short run's set-up.
+    triples = triples[:1] if np.all(triples == triples[:1]) else np.unique(triples, axis=0)
     steps = [math.inf]
     for m_a, m_b, kappa in triples:
         contact = hertz_contact_time(float(m_a), float(m_b), np.float64(kappa), relative)
