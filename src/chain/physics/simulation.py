@@ -112,19 +112,20 @@ class SimulationResult:
     model : ChainModel
     time : (S,) s
     v_left, v_right : (B,) launch speeds, m/s
-    contact_force : (B, S, K) N; the recorded contacts (all N-1 by default: contact k,
-        joining beads k and k+1, at index k-1); see :attr:`contacts`
+    contact_force : (B, S, K) N; the recorded contacts (all N-1 of a short chain by
+        default: contact k, joining beads k and k+1, at index k-1); see :attr:`contacts`
     end_force : (B, S, 2) N; force on bead 1 from its left (wall or striker) and on bead
         N from its right; zero for a free end
     bead_velocity : (B, S, Q) m/s; centre-of-mass velocity of each recorded bead (all N
-        by default); see :attr:`beads`
+        of a short chain by default); see :attr:`beads`
     sensor_force : (B, S, n_sensors) N; sensor-spring readings k_s * compression
     kinetic_energy, potential_energy, dissipated_energy : (B, S) J
     momentum : (B, S) kg m/s (all particles, strikers included)
     dt : s, the integration step
     contacts, beads : tuple of int or None
-        Contact and bead numbers recorded when ``simulate`` was asked for a selection;
-        None when all were recorded.
+        Contact and bead numbers recorded, in column order, when not all were (a
+        selection, or the overview of a long chain: :func:`default_record`); None when
+        all were recorded.
     """
 
     model: ChainModel
