@@ -1,4 +1,4 @@
-"""Where the lean kernel's time goes in bench_integrator.py's DOP853 comparison (issue 14).
+"""Where chain.simulate's time goes, against C (issue 25) and DOP853 (issue 14).
 
 Run from the repository root::
 
@@ -9,7 +9,9 @@ One collision in the paper's chain (N = 26, +V0 / -V0, 2 ms, every contact force
 velocity and the energies recorded every 1 us) at the default step. CPU times, best of
 ``--repeat`` interleaved rounds, of:
 
-* ``integrate()``: the public call that bench_integrator.py times;
+* ``simulate()``: the call a user makes, with its defaults (every contact and bead);
+* ``integrate()``: the lean kernel's public wrapper, which ``simulate`` calls;
+* the C yardstick (``benchmarks/c/rk4_chain.c``, ``-O3 -march=native``) at the same step;
 * ``integrate()`` for one step (the wrapper's fixed cost);
 * the numba kernel called directly, with freshly allocated outputs and with outputs
   allocated once before (integrate() minus this is the wrapper and the allocation,
@@ -34,16 +36,16 @@ import importlib.util
 import math
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
-from bench_integrator import dop853
+from bench_integrator import c_run, dop853
+from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, load_c
 
 from chain.physics import kernels
 from chain.physics.integrator import _lean_params, _outputs, integrate
 from chain.physics.model import launch_velocities, uniform_chain
-from chain.physics.simulation import default_time_step
+from chain.physics.simulation import default_time_step, simulate
 
 N_BEADS = 26
 DURATION = 2e-3  # s
@@ -70,9 +72,7 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
         ("cache=True", "cache=False"),
     ]
     if not refine:  # detect events (same work) but keep the coarse step
-        edits.append(
-            ("            event = varied or end[2] != slope[2]\n", "            event = False\n")
-        )
+        edits.append(("        if not (varied or end[2] != slope[2]):\n", "        if True:\n"))
     for old, new in edits:
         assert old in source, f"kernels.py changed: {old!r} not found"
         source = source.replace(old, new)
@@ -86,19 +86,9 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
     return module
 
 
-def best_times(contenders: dict, repeat: int) -> dict:
-    best = dict.fromkeys(contenders, math.inf)
-    for _ in range(repeat):
-        for name, function in contenders.items():
-            start = time.process_time()
-            function()
-            best[name] = min(best[name], time.process_time() - start)
-    return best
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--repeat", type=int, default=MIN_REPEAT)
     parser.add_argument("--eta", type=float, default=0.0, help="Kuwabara-Kono time, s")
     parser.add_argument("--speed", type=float, default=0.3, help="V0, m/s")
     parser.add_argument(
@@ -109,6 +99,8 @@ def main() -> None:
         help="also time DOP853 (bench_integrator.dop853, elastic only) at these rtol",
     )
     args = parser.parse_args()
+    conditions = Conditions()
+    conditions.sample("before")
     model = uniform_chain(N_BEADS, eta=args.eta)
     velocity = launch_velocities(model, args.speed, args.speed)
     dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, args.speed))
@@ -134,6 +126,7 @@ def main() -> None:
         return run
 
     contenders = {
+        "simulate()": lambda: simulate(model, args.speed, args.speed, duration=DURATION),
         "integrate()": lambda: integrate(model, velocity, DURATION, dt, every),
         "integrate(), one step": lambda: integrate(model, velocity, dt, dt, every),
         "kernel, fresh outputs": direct(),
@@ -144,6 +137,10 @@ def main() -> None:
         variants = {label: patched_kernel(Path(folder), *rest) for label, *rest in SCHEMES}
         for label, module in variants.items():
             contenders[label] = direct(module, outputs=warm)
+        c_function, how = load_c(folder)
+        print(f"C yardstick: {how}")
+        if c_function is not None:
+            contenders["C"] = lambda: c_run(c_function, velocity[0], args.eta, dt, n_steps, every)
         if args.eta == 0:
             for rtol in args.rtol:
                 contenders[f"DOP853 rtol {rtol:.2e}"] = lambda r=rtol: dop853(
@@ -154,9 +151,13 @@ def main() -> None:
         best = best_times(contenders, args.repeat)
     print(
         f"N = {N_BEADS}, V0 = {args.speed} m/s, eta = {args.eta:.2e} s, dt = {dt:.4e} s, "
-        f"{n_steps} steps, {n_samples} samples; CPU ms, best of {args.repeat}"
+        f"{n_steps} steps, {n_samples} samples; CPU ms, best of {args.repeat}; C flags "
+        f"{' '.join(C_FLAGS)}"
     )
-    total = best["integrate()"]
+    conditions.sample("after")
+    if conditions.under_load:
+        print("UNDER LOAD: the shares below are indicative only")
+    total = best["simulate()"]
     runs = {}
     for label in ["kernel, warm outputs", *variants]:
         out, (_, _, refined) = contenders[label]()
@@ -179,20 +180,29 @@ def main() -> None:
         print(line)
     kernel = best["kernel, warm outputs"]
     parts = {
-        "wrapper + output allocation": total - kernel,
+        "simulate(): checks, default step, bead view": total - best["integrate()"],
+        "integrate(): wrapper, output allocation": best["integrate()"] - kernel,
         "recording (1 us)": kernel - best["kernel, no records"],
         "contact-event refinement": kernel - best["no refinement"],
     }
     parts["plain steps + event detection"] = total - sum(parts.values())
-    print("breakdown of integrate():")
+    print("breakdown of simulate():")
     for label, seconds in parts.items():
-        print(f"  {label:30s} {seconds * 1e3:6.2f} ms  {seconds / total * 100:5.1f} %")
+        line = f"  {label:45s} {seconds * 1e3:6.2f} ms  {seconds / total * 100:5.1f} %"
+        if "C" in best:
+            line += f"  {seconds / best['C']:5.2f} x C"
+        print(line)
     plain = parts["plain steps + event detection"]
+    if "C" in best:
+        print(
+            f"simulate() / C = {total / best['C']:.2f}; integrate() / C = "
+            f"{best['integrate()'] / best['C']:.2f}; plain steps / C = {plain / best['C']:.2f}"
+        )
     for label, seconds in best.items():
         if label.startswith("DOP853"):
             print(
-                f"{label} / integrate() = {seconds / total:.1f}; / plain steps alone = "
-                f"{seconds / plain:.1f} (the ceiling if the wrapper, recording and "
+                f"{label} / simulate() = {seconds / total:.1f}; / plain steps alone = "
+                f"{seconds / plain:.1f} (the ceiling if the wrappers, recording and "
                 "refinement cost nothing)"
             )
 

@@ -125,3 +125,40 @@ def test_simulate_records_only_what_is_asked():
     assert part.contact_force.shape[2] == 2 and part.bead_velocity.shape[2] == 2
     with pytest.raises(ParameterError, match="contact 7 was not recorded"):
         part.contact(7)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_sweep_in_one_pool_gives_the_bits_of_separate_calls(threads):
+    """simulate_many (every launch of several chains in one thread pool, longest
+    first) gives each run the bits of its own simulate call, on one thread or two;
+    shared arguments apply to every run, a run's own win; unknown names are refused."""
+    from chain.errors import ParameterError
+    from chain.physics.integrator import integrate_many
+    from chain.physics.simulation import simulate, simulate_many
+
+    runs = [
+        {"model": MODELS[name](), "v_left": [0.3, 0.05], "v_right": [0.3, 0.0]} for name in MODELS
+    ]
+    runs[1]["duration"] = 2e-4
+    together = simulate_many(runs, threads=threads, duration=3e-4, record_interval=2e-6)
+    for run, result in zip(runs, together, strict=True):
+        alone = simulate(**{"duration": 3e-4, "record_interval": 2e-6, **run})
+        for field in ("time", "contact_force", "end_force", "bead_velocity", "sensor_force"):
+            np.testing.assert_array_equal(getattr(result, field), getattr(alone, field), field)
+        np.testing.assert_array_equal(result.total_energy, alone.total_energy)
+    assert together[1].time[-1] == pytest.approx(2e-4)
+    with pytest.raises(ParameterError, match="unknown"):
+        simulate_many([{**runs[0], "speed": 1.0}])
+    model = MODELS["elastic"]()
+    with pytest.raises(ParameterError, match="lean"):
+        integrate_many(
+            [
+                dict(
+                    model=model,
+                    initial_velocity=launch_velocities(model, 0.1),
+                    duration=1e-5,
+                    dt=1e-7,
+                    kernel="reference",
+                )
+            ]
+        )

@@ -277,3 +277,59 @@ def test_readers_reject_bad_indices():
         result.force_felt(5)
     with pytest.raises(ParameterError, match="not a sensor bead"):
         result.sensor(2)
+
+
+# --------------------------------------------------------------------------- what is recorded
+
+
+def test_a_long_chain_records_an_overview_by_default(monkeypatch):
+    """Beyond OVERVIEW_CONTACTS contacts the default record is every stride-th contact
+    and bead, the last ones and the sensors' (so every sensor bead's felt force reads),
+    each column bit-identical to the same column of contacts="all"; a contact outside
+    the overview is refused with the keyword to ask for it."""
+    from chain.physics import record
+
+    monkeypatch.setattr(record, "OVERVIEW_CONTACTS", 8)
+    model = uniform_chain(40)
+    kwargs = {"duration": 2e-4, "record_interval": 2e-6}
+    overview = simulate(model, 0.3, 0.3, **kwargs)
+    full = simulate(model, 0.3, 0.3, contacts="all", beads="all", **kwargs)
+    stride = math.ceil(39 / 8)
+    assert overview.contacts == (*range(1, 40, stride), 39)
+    assert overview.beads == (*range(1, 41, stride), 40)
+    assert full.contacts is None and full.beads is None
+    for k in overview.contacts:
+        assert np.array_equal(overview.contact(k), full.contact(k))
+    for n in overview.beads:
+        assert np.array_equal(overview.velocity(n), full.velocity(n))
+    with pytest.raises(ParameterError, match="contacts="):
+        overview.contact(2)
+    sensed = uniform_chain(40, sensor_beads=(13, 27))
+    with_sensors = simulate(sensed, 0.3, 0.3, **kwargs)
+    every = simulate(sensed, 0.3, 0.3, contacts="all", **kwargs)
+    assert {12, 13, 26, 27} <= set(with_sensors.contacts)
+    assert {13, 27} <= set(with_sensors.beads)
+    for bead in (13, 27):
+        assert np.array_equal(with_sensors.force_felt(bead), every.force_felt(bead))
+    short = simulate(uniform_chain(9), 0.3, 0.3, **kwargs)
+    assert short.contacts is None and short.contact_force.shape[2] == 8
+
+
+def test_a_large_record_warns_and_says_how_to_record_less(monkeypatch):
+    """A record over RECORD_WARNING_BYTES warns (LargeRecordWarning) with the keywords
+    that choose less; a selection under it runs silently."""
+    import warnings
+
+    from chain.physics import record
+
+    model = uniform_chain(20)
+    kwargs = {"duration": 1e-4, "record_interval": 1e-6}
+    # 101 samples x (19 contacts + 2 x 20 bead velocities) x 8 bytes = 47.7 kB.
+    monkeypatch.setattr(record, "RECORD_WARNING_BYTES", 40e3)
+    with pytest.warns(record.LargeRecordWarning, match=r"contacts=.*beads=\(\)"):
+        simulate(model, 0.3, 0.3, contacts="all", **kwargs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        simulate(model, 0.3, 0.3, contacts=range(1, 20, 4), beads=(), **kwargs)
+    with pytest.raises(ParameterError, match="contacts"):
+        simulate(model, 0.3, 0.3, contacts="every", **kwargs)

@@ -134,3 +134,6 @@ def test_slurm_profile_gives_jobs_their_resources():
     assert re.search(r"mem_mb=\d+00,.*runtime=\d+.*cpus_per_task=1", simulate), simulate
     fig1 = out[out.index("rule fig1_setup:") :].split("\n\n")[0]
     assert re.search(r"mem_mb=1000,.*runtime=15.*cpus_per_task=1", fig1), fig1
+    # Small simulation jobs share SLURM jobs (groups of up to 8): one allocation, one
+    # queue wait for several chains.
+    assert "Group job simulations" in out

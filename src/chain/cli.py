@@ -15,7 +15,7 @@ from chain.errors import ParameterError
 from chain.physics.integrator import IntegrationError
 from chain.physics.materials import MATERIALS, get_material
 from chain.physics.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
-from chain.physics.simulation import DEFAULT_RECORD_INTERVAL, simulate
+from chain.physics.simulation import DEFAULT_RECORD_INTERVAL, felt_contacts, simulate
 from chain.traces import TraceFormatError, write_traces
 
 _DESCRIPTION = """\
@@ -244,6 +244,9 @@ def _simulate(args: argparse.Namespace) -> int:
         duration=args.duration,
         dt=args.dt,
         record_interval=args.record_interval,
+        # Only what the table reads (sensor springs are always kept).
+        contacts=() if args.sensor_beads else felt_contacts(model, beads),
+        beads=(),
     )
     table = trace_table(
         result,

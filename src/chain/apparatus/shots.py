@@ -20,7 +20,7 @@ from chain.physics.simulation import (
     SimulationResult,
     default_time_step,
     felt_contacts,
-    simulate,
+    simulate_many,
 )
 from chain.traces import META_COLUMNS, sensor_column
 
@@ -153,19 +153,21 @@ def simulate_shots(
     dt = shot_time_step(model, speeds, dt, record_interval)
     tables = []
     runs = []
-    for offset, (kind, right) in enumerate((("collision", speeds), ("reference", 0.0 * speeds))):
-        result = simulate(
-            model,
-            speeds,
-            right,
-            duration=duration,
-            dt=dt,
-            record_interval=record_interval,
-            max_energy_drift=max_energy_drift,
-            # Record only what the readout reads (sensor springs are always kept).
-            contacts=felt_contacts(model, sensor_beads) if readout == "felt" else (),
-            beads=(),
-        )
+    kinds = ("collision", "reference")
+    # Both batches in one thread pool: every core busy until the last launch.
+    results = simulate_many(
+        [{"v_right": speeds}, {"v_right": 0.0 * speeds}],
+        model=model,
+        v_left=speeds,
+        duration=duration,
+        dt=dt,
+        record_interval=record_interval,
+        max_energy_drift=max_energy_drift,
+        # Record only what the readout reads (sensor springs are always kept).
+        contacts=felt_contacts(model, sensor_beads) if readout == "felt" else (),
+        beads=(),
+    )
+    for offset, (kind, result) in enumerate(zip(kinds, results, strict=True)):
         first = offset * len(speeds)
         tables.append(
             trace_table(

@@ -30,9 +30,12 @@ __getattr__, __dir__, __all__ = lazy_exports(
             ],
             "chain.physics.model",
         ),
-        **dict.fromkeys(["IntegrationError", "integrate"], "chain.physics.integrator"),
         **dict.fromkeys(
-            ["SimulationResult", "default_time_step", "simulate"], "chain.physics.simulation"
+            ["IntegrationError", "integrate", "integrate_many"], "chain.physics.integrator"
+        ),
+        **dict.fromkeys(
+            ["SimulationResult", "default_time_step", "simulate", "simulate_many"],
+            "chain.physics.simulation",
         ),
     },
 )

@@ -11,13 +11,15 @@ dissipation, which makes the energy drift a check on the step in every run.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import lru_cache, partial
 
 import numba
 import numpy as np
 
-from chain.errors import ParameterError, require_positive
+from chain.errors import ParameterError, require_int, require_positive
 from chain.physics import reference_kernel
 from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_one
 from chain.physics.model import HERTZ, SPRING, ChainModel
@@ -124,6 +126,83 @@ def integrate(
     -------
     RawTrajectory
     """
+    batch = _prepare(
+        model,
+        initial_velocity,
+        duration,
+        dt,
+        record_every,
+        initial_displacement,
+        max_energy_drift,
+        links,
+        particles,
+        kernel,
+    )
+    _run_launches(batch.launches, numba.get_num_threads())
+    return _finish(batch)
+
+
+def integrate_many(batches: Sequence[Mapping], threads: int | None = None) -> list[RawTrajectory]:
+    """Integrate several batches (different chains, steps, durations) at once: every
+    launch of every batch is one task of one pool of ``threads`` threads, longest first,
+    so that a sweep of many small chains keeps every core busy.
+
+    Each launch gives the same bits as :func:`integrate` would (one launch runs on one
+    thread, whatever the pool).
+
+    Parameters
+    ----------
+    batches : sequence of mappings
+        Keyword arguments of :func:`integrate`, one mapping per batch (``model``,
+        ``initial_velocity``, ``duration``, ``dt`` required; ``kernel`` must be "lean").
+    threads : int, optional
+        Threads of the pool; default numba's thread count (all cores unless limited by
+        ``NUMBA_NUM_THREADS`` or :func:`numba.set_num_threads`).
+
+    Returns
+    -------
+    list of RawTrajectory
+        One per batch, in order.
+    """
+    prepared = []
+    for number, arguments in enumerate(batches):
+        if arguments.get("kernel", "lean") != "lean":
+            raise ParameterError(f"batch {number}: integrate_many runs the lean kernel only")
+        prepared.append(_prepare(**{"record_every": 1, **arguments}))
+    threads = numba.get_num_threads() if threads is None else require_int("threads", threads, 1)
+    _run_launches([launch for batch in prepared for launch in batch.launches], threads)
+    return [_finish(batch) for batch in prepared]
+
+
+@dataclass
+class _Batch:
+    """A batch ready to run: its records, its report and one task per launch (cost in
+    particle-steps, function)."""
+
+    model: ChainModel
+    run: tuple
+    n_samples: int
+    links: np.ndarray
+    particles: np.ndarray
+    max_energy_drift: float
+    outputs: tuple | list
+    report: tuple
+    launches: list
+
+
+def _prepare(
+    model,
+    initial_velocity,
+    duration,
+    dt,
+    record_every=1,
+    initial_displacement=None,
+    max_energy_drift=DEFAULT_MAX_ENERGY_DRIFT,
+    links=None,
+    particles=None,
+    kernel="lean",
+) -> _Batch:
+    """The checked inputs of :func:`integrate`, records allocated, launches not run."""
     duration, dt, record_every = _check_run(duration, dt, record_every, max_energy_drift)
     velocity, displacement = _initial_state(model, initial_velocity, initial_displacement)
     links = _index_array("links", links, model.n_particles - 1)
@@ -134,21 +213,29 @@ def integrate(
     n_samples = n_steps // record_every + 1
     run = (displacement, velocity, dt, n_steps, record_every)
     if kernel == "lean":
-        outputs, report = _run_lean(model, run, n_samples, links, particles)
+        outputs, report, launches = _lean_launches(model, run, n_samples, links, particles)
     else:
-        outputs, report = _run_reference(model, run, n_samples, links, particles)
-    _raise_on_blow_up(report, dt)
+        outputs, report, launches = _reference_launches(model, run, n_samples, links, particles)
+    return _Batch(
+        model, run, n_samples, links, particles, max_energy_drift, outputs, report, launches
+    )
+
+
+def _finish(batch: _Batch) -> RawTrajectory:
+    """The trajectory of a batch whose launches ran; raises on a blow-up or a drift."""
+    displacement, velocity, dt, _, record_every = batch.run
+    _raise_on_blow_up(batch.report, dt)
     trajectory = RawTrajectory(
-        np.arange(n_samples) * (record_every * dt),
-        *outputs,
+        np.arange(batch.n_samples) * (record_every * dt),
+        *batch.outputs,
         final_displacement=displacement,
         final_velocity=velocity,
         dt=dt,
-        refined_steps=report[2],
-        links=links,
-        particles=particles,
+        refined_steps=batch.report[2],
+        links=batch.links,
+        particles=batch.particles,
     )
-    _raise_on_drift(trajectory.energy_drift, max_energy_drift, dt)
+    _raise_on_drift(trajectory.energy_drift, batch.max_energy_drift, dt)
     return trajectory
 
 
@@ -206,16 +293,25 @@ def _report(batch: int):
     return tuple(np.zeros(batch, dtype=np.int64) for _ in range(3))
 
 
+@lru_cache(maxsize=256)
+def _contact_keys(n_links: int) -> np.ndarray:
+    """One fixed random 64-bit key per link and per wall (read-only), so that runs are
+    reproducible; drawn once per chain length (a quarter of a short run's set-up)."""
+    keys = np.random.default_rng(_KEY_SEED).integers(
+        0, np.iinfo(np.uint64).max, size=n_links + 2, dtype=np.uint64, endpoint=True
+    )
+    keys.flags.writeable = False
+    return keys
+
+
 def _lean_params(model: ChainModel) -> tuple:
     """The model as the flat arrays of :mod:`chain.physics.kernels` (see ``_slopes``)."""
     kind = np.ascontiguousarray(model.link_kind, dtype=np.int64)
     damping = 1.5 * model.link_eta * model.link_stiffness
     damping[kind == SPRING] = 0.0
     n_links = model.n_particles - 1
-    # One key per link and per wall, fixed, so that runs are reproducible.
-    keys = np.random.default_rng(_KEY_SEED).integers(
-        0, np.iinfo(np.uint64).max, size=n_links + 2, dtype=np.uint64, endpoint=True
-    )
+    # A copy: the kernels take writable arrays (a read-only one is another signature).
+    keys = _contact_keys(n_links).copy()
     springs = np.r_[np.flatnonzero(kind == SPRING), n_links].astype(np.int64)
     walls = np.stack([model.wall_stiffness, 1.5 * model.wall_eta * model.wall_stiffness], axis=1)
     drag = np.stack([model.drag_rate, model.masses * model.drag_rate], axis=1)
@@ -237,7 +333,8 @@ def _lean_params(model: ChainModel) -> tuple:
     )
 
 
-def _run_lean(model: ChainModel, run, n_samples: int, links, particles):
+def _lean_launches(model: ChainModel, run, n_samples: int, links, particles):
+    """(outputs, report, launches) of a batch for the lean kernel."""
     displacement, velocity, dt, n_steps, record_every = run
     batch = velocity.shape[0]
     outputs = _outputs(batch, n_samples, len(links), len(particles))
@@ -251,22 +348,32 @@ def _run_lean(model: ChainModel, run, n_samples: int, links, particles):
         )
         status[b], fail_step[b], refined[b] = result
 
-    # Launches are independent and the kernel releases the GIL: one thread per core,
-    # each launch on one thread, so the results do not depend on the thread count.
-    workers = min(batch, numba.get_num_threads())
-    if workers == 1:
-        for b in range(batch):
-            launch(b)
-    else:
-        with ThreadPoolExecutor(max_workers=workers) as pool:
-            list(pool.map(launch, range(batch)))
-    return outputs, report
+    cost = n_steps * model.n_particles
+    return outputs, report, [(cost, partial(launch, b)) for b in range(batch)]
 
 
-def _run_reference(model: ChainModel, run, n_samples: int, links, particles):
+def _run_launches(launches: list, threads: int) -> None:
+    """Run (cost, function) tasks, on ``threads`` threads when there are several.
+
+    Launches are independent and the kernel releases the GIL: each launch runs on one
+    thread, so the results do not depend on the thread count. The longest go first, so
+    that no thread is left with a long launch at the end of a sweep."""
+    workers = min(len(launches), threads)
+    if workers <= 1:
+        for _, function in launches:
+            function()
+        return
+    ordered = sorted(launches, key=lambda task: -task[0])
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        list(pool.map(lambda task: task[1](), ordered))
+
+
+def _reference_launches(model: ChainModel, run, n_samples: int, links, particles):
+    """(outputs, report, launches) of a batch for the reference kernel: one task that
+    runs the whole batch, then keeps the recorded links and particles."""
     displacement, velocity, dt, n_steps, record_every = run
     n_particles = model.n_particles
-    outputs = _outputs(velocity.shape[0], n_samples, max(n_particles - 1, 1), n_particles)
+    full = _outputs(velocity.shape[0], n_samples, max(n_particles - 1, 1), n_particles)
     report = _report(velocity.shape[0])
     link_damping = 1.5 * model.link_eta * model.link_stiffness
     link_damping[model.link_kind == SPRING] = 0.0
@@ -281,12 +388,23 @@ def _run_reference(model: ChainModel, run, n_samples: int, links, particles):
         np.ascontiguousarray(model.drag_rate, dtype=float),
         bool(np.any(model.drag_rate > 0)),
     )
-    reference_kernel._integrate_batch(
-        displacement, velocity, params, dt, n_steps, record_every, *outputs, *report
-    )
-    link_force, wall_force, recorded_velocity, energy, momentum = outputs
-    selected = (link_force[:, :, links], wall_force, recorded_velocity[:, :, particles])
-    return (*selected, energy, momentum), report
+    outputs = [None] * 5
+
+    def launch() -> None:
+        reference_kernel._integrate_batch(
+            displacement, velocity, params, dt, n_steps, record_every, *full, *report
+        )
+        link_force, wall_force, recorded_velocity, energy, momentum = full
+        outputs[:] = (
+            link_force[:, :, links],
+            wall_force,
+            recorded_velocity[:, :, particles],
+            energy,
+            momentum,
+        )
+
+    # ``outputs`` is filled in place when the task runs.
+    return outputs, report, [(n_steps * n_particles, launch)]
 
 
 def _raise_on_blow_up(report, dt: float) -> None:
@@ -332,4 +450,5 @@ __all__ = [
     "IntegrationError",
     "RawTrajectory",
     "integrate",
+    "integrate_many",
 ]

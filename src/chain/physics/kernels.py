@@ -326,6 +326,38 @@ def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag):
     return increment, event, slope
 
 
+@numba.njit(cache=True, inline="always")
+def _step(
+    x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, refine, dt, im, k, c, keys, springs, walls, drag
+):
+    """One step from the state in x (slopes ``x_acc``, ``slope``): the plain RK4 step
+    into y, or, at a contact event and the EVENT_AFTERMATH steps after it (``refine``
+    > 0), EVENT_SUBSTEPS substeps whose end state is left in x. Returns (dissipated
+    energy, end slope, refine, whether the step was refined, whether the state moved
+    to y).
+
+    Inlined at two call sites, one per order of the arrays, so that the loop never
+    swaps array variables: a swap costs reference-count updates (measured: the paper's
+    collision ran 9-12 % faster without them, same bits; the price is a longer cold
+    compilation)."""
+    if refine == 0:
+        buffers = (work[0], work[1], work[2], work[3], work[4], y_u, y_v)
+        increment, varied = _rk4(
+            x_u, x_v, x_acc, slope, dt, buffers, im, k, c, keys, springs, walls, drag
+        )
+        end = _slopes(y_u, y_v, y_acc, im, k, c, keys, springs, walls, drag)
+        if not (varied or end[2] != slope[2]):
+            return increment, end, refine, False, True
+        refine = EVENT_AFTERMATH + 1
+    increment, varied, end = _substeps(
+        (x_u, x_v, y_u, y_v), x_acc, slope, dt, work, im, k, c, keys, springs, walls, drag
+    )
+    refine -= 1
+    if varied or end[2] != slope[2]:
+        refine = EVENT_AFTERMATH
+    return increment, end, refine, True, False
+
+
 @numba.njit(cache=True, nogil=True)
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
     """RK4 for one launch; ``u`` and ``v`` end as the final state. Returns the status,
@@ -343,28 +375,22 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     dissipated = 0.0
     _record(x_u, x_v, dissipated, recorded, links, particles, 0, outputs)
     refine = refined = step = 0
+    in_y = False  # the state is in (y_u, y_v, y_acc), else in (x_u, x_v, x_acc)
     status = _OK
     while step < n_steps and status == _OK:
         step += 1
-        event = refine > 0
-        if not event:
-            buffers = (work[0], work[1], work[2], work[3], work[4], y_u, y_v)
-            increment, varied = _rk4(
-                x_u, x_v, x_acc, slope, dt, buffers, im, k, c, keys, springs, walls, drag
-            )
-            end = _slopes(y_u, y_v, y_acc, im, k, c, keys, springs, walls, drag)
-            event = varied or end[2] != slope[2]
-            if event:
-                refine = EVENT_AFTERMATH + 1
-            else:
-                x_u, y_u, x_v, y_v, x_acc, y_acc = y_u, x_u, y_v, x_v, y_acc, x_acc
-        if event:
-            increment, varied, end = _substeps(
-                (x_u, x_v, y_u, y_v),
+        if in_y:
+            increment, slope, refine, substeps, moved = _step(
+                y_u,
+                y_v,
+                y_acc,
+                x_u,
+                x_v,
                 x_acc,
-                slope,
-                dt,
                 work,
+                slope,
+                refine,
+                dt,
                 im,
                 k,
                 c,
@@ -373,16 +399,40 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
                 walls,
                 drag,
             )
-            refine -= 1
-            refined += 1
-            if varied or end[2] != slope[2]:
-                refine = EVENT_AFTERMATH
-        slope = end
+        else:
+            increment, slope, refine, substeps, moved = _step(
+                x_u,
+                x_v,
+                x_acc,
+                y_u,
+                y_v,
+                y_acc,
+                work,
+                slope,
+                refine,
+                dt,
+                im,
+                k,
+                c,
+                keys,
+                springs,
+                walls,
+                drag,
+            )
+        refined += substeps
+        in_y = in_y != moved
         dissipated += increment
         if step % record_every == 0:
             sample = step // record_every
-            if not _record(x_u, x_v, dissipated, recorded, links, particles, sample, outputs):
+            if in_y:
+                finite = _record(y_u, y_v, dissipated, recorded, links, particles, sample, outputs)
+            else:
+                finite = _record(x_u, x_v, dissipated, recorded, links, particles, sample, outputs)
+            if not finite:
                 status = _NOT_FINITE
+    if in_y:
+        _copy_into(x_u, y_u)
+        _copy_into(x_v, y_v)
     if status == _OK and not (_all_finite(x_u) and _all_finite(x_v)):
         status = _NOT_FINITE
     _copy_into(u, x_u)

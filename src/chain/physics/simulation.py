@@ -8,14 +8,33 @@
 
 from __future__ import annotations
 
+import inspect
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from chain.errors import ParameterError, require_positive
-from chain.physics.integrator import DEFAULT_MAX_ENERGY_DRIFT, RawTrajectory, integrate
+from chain.physics.integrator import (
+    DEFAULT_MAX_ENERGY_DRIFT,
+    RawTrajectory,
+    integrate,
+    integrate_many,
+)
 from chain.physics.model import HERTZ, SPRING, ChainModel, launch_velocities
+from chain.physics.record import (
+    ALL,
+    OVERVIEW_CONTACTS,
+    RECORD_WARNING_BYTES,
+    LargeRecordWarning,
+    default_record,
+    felt_contacts,
+    links_to_record,
+    particles_to_record,
+    recorded,
+    warn_if_large,
+)
 from chain.physics.theory import hertz_contact_time
 
 #: Steps per shortest two-body contact time in the default time step. The exact
@@ -52,9 +71,9 @@ def default_time_step(model: ChainModel, max_launch_speed: float) -> float:
     moving = _moving_masses(model)
     hertz = np.flatnonzero(model.link_kind == HERTZ)
     # Linear in N: the Hertz time is computed once per distinct (m_a, m_b, kappa).
-    triples = np.unique(
-        np.stack([moving[hertz], moving[hertz + 1], model.link_stiffness[hertz]], axis=1), axis=0
-    )
+    triples = np.stack([moving[hertz], moving[hertz + 1], model.link_stiffness[hertz]], axis=1)
+    # A uniform chain has one triple: np.unique's sort is most of a short run's set-up.
+    triples = triples[:1] if np.all(triples == triples[:1]) else np.unique(triples, axis=0)
     steps = [math.inf]
     for m_a, m_b, kappa in triples:
         contact = hertz_contact_time(float(m_a), float(m_b), np.float64(kappa), relative)
@@ -84,24 +103,6 @@ def _moving_masses(model: ChainModel) -> np.ndarray:
     return moving
 
 
-def felt_contacts(model: ChainModel, beads) -> tuple[int, ...]:
-    """The contacts whose forces :meth:`SimulationResult.force_felt` reads for ``beads``:
-    k = n-1 and n for bead n (an end bead's outer side is the end force, always kept).
-
-    Pass them as ``simulate(..., contacts=...)`` to record only what a readout needs.
-
-    Parameters
-    ----------
-    model : ChainModel
-        The chain.
-    beads : sequence of int
-        Bead numbers n, 1..N.
-    """
-    n_beads = model.n_beads
-    wanted = {k for n in beads for k in (int(n) - 1, int(n)) if 1 <= k <= n_beads - 1}
-    return tuple(sorted(wanted))
-
-
 @dataclass(frozen=True)
 class SimulationResult:
     """A batch of simulated launches of one chain, indexed the way a person reads it.
@@ -111,19 +112,20 @@ class SimulationResult:
     model : ChainModel
     time : (S,) s
     v_left, v_right : (B,) launch speeds, m/s
-    contact_force : (B, S, K) N; the recorded contacts (all N-1 by default: contact k,
-        joining beads k and k+1, at index k-1); see :attr:`contacts`
+    contact_force : (B, S, K) N; the recorded contacts (all N-1 of a short chain by
+        default: contact k, joining beads k and k+1, at index k-1); see :attr:`contacts`
     end_force : (B, S, 2) N; force on bead 1 from its left (wall or striker) and on bead
         N from its right; zero for a free end
     bead_velocity : (B, S, Q) m/s; centre-of-mass velocity of each recorded bead (all N
-        by default); see :attr:`beads`
+        of a short chain by default); see :attr:`beads`
     sensor_force : (B, S, n_sensors) N; sensor-spring readings k_s * compression
     kinetic_energy, potential_energy, dissipated_energy : (B, S) J
     momentum : (B, S) kg m/s (all particles, strikers included)
     dt : s, the integration step
     contacts, beads : tuple of int or None
-        Contact and bead numbers recorded when ``simulate`` was asked for a selection;
-        None when all were recorded.
+        Contact and bead numbers recorded, in column order, when not all were (a
+        selection, or the overview of a long chain: :func:`default_record`); None when
+        all were recorded.
     """
 
     model: ChainModel
@@ -236,13 +238,90 @@ def simulate(
         Particle displacements at t = 0, m (default 0: all particles just touching).
         A positive value on the right striker (or negative on the left one) is an
         initial gap, which delays that launch by gap / speed.
-    contacts : sequence of int, optional
-        Contacts (1..N-1) whose force is recorded; default all. Record only what you
-        read: a long chain's full record is N x samples x 8 bytes per launch. Sensor
-        springs, strikers, walls, energies and momentum are always recorded.
-    beads : sequence of int, optional
-        Beads (1..N) whose velocity is recorded; default all; ``()`` for none.
+    contacts : sequence of int or "all", optional
+        Contacts (1..N-1) whose force is recorded. Default: every contact for a chain
+        of up to :data:`OVERVIEW_CONTACTS` contacts, an overview for a longer one (every
+        stride-th contact and the sensors', :func:`default_record`). ``"all"``
+        (:data:`ALL`) records every contact of any chain: N x samples x 8 bytes per
+        launch. Sensor springs, strikers, walls, energies and momentum are always
+        recorded. A record over :data:`RECORD_WARNING_BYTES` warns
+        (:class:`LargeRecordWarning`) and says how to record less.
+    beads : sequence of int or "all", optional
+        Beads (1..N) whose velocity is recorded; default as for ``contacts`` (every
+        bead, or every stride-th bead and the sensor beads); ``()`` for none.
     """
+    arguments, view = _request(
+        model,
+        v_left,
+        v_right,
+        duration,
+        dt,
+        record_interval,
+        max_energy_drift,
+        initial_displacement,
+        contacts,
+        beads,
+    )
+    return view(integrate(**arguments))
+
+
+def simulate_many(runs: Sequence[Mapping], threads: int | None = None, **common) -> list:
+    """Simulate many batches (chains, speeds) at once on all cores: a sweep.
+
+    Every launch of every run is one task of one thread pool, longest first (see
+    :func:`chain.physics.integrator.integrate_many`), so that a sweep of many small
+    chains keeps every core busy and pays no Python between launches. Each result is
+    bit-identical to :func:`simulate` with the same arguments.
+
+    Parameters
+    ----------
+    runs : sequence of mappings
+        Arguments of :func:`simulate` per run (``model`` and ``v_left`` at least; m/s,
+        s as there).
+    threads : int, optional
+        Threads of the pool; default numba's thread count.
+    **common
+        Arguments of :func:`simulate` shared by every run (a run's own win), e.g.
+        ``duration=2e-3, contacts=()``.
+
+    Returns
+    -------
+    list of SimulationResult
+        One per run, in order.
+    """
+    requests = [_request(**_simulate_arguments({**common, **run})) for run in runs]
+    raws = integrate_many([arguments for arguments, _ in requests], threads)
+    return [view(raw) for (_, view), raw in zip(requests, raws, strict=True)]
+
+
+def _simulate_arguments(arguments: Mapping) -> dict:
+    """``arguments`` of :func:`simulate` completed with its defaults, checked by name."""
+    names = inspect.signature(simulate).parameters
+    unknown = sorted(set(arguments) - set(names))
+    if unknown:
+        raise ParameterError(f"simulate_many: unknown arguments {unknown}; known: {list(names)}")
+    defaults = {
+        name: parameter.default
+        for name, parameter in names.items()
+        if parameter.default is not inspect.Parameter.empty
+    }
+    return {**defaults, **arguments}
+
+
+def _request(
+    model,
+    v_left,
+    v_right,
+    duration,
+    dt,
+    record_interval,
+    max_energy_drift,
+    initial_displacement,
+    contacts,
+    beads,
+):
+    """(keyword arguments of integrate, function that reads its RawTrajectory by bead)
+    for :func:`simulate`'s arguments, checked."""
     velocities = launch_velocities(model, v_left, v_right)
     left = np.atleast_1d(np.asarray(v_left, dtype=float))
     right = np.atleast_1d(np.asarray(v_right, dtype=float))
@@ -256,45 +335,23 @@ def simulate(
         dt = record_interval / math.ceil(record_interval / default_time_step(model, fastest))
     dt = require_positive("dt", dt)
     record_every = max(1, round(record_interval / dt))
-    contacts = _numbers("contacts", contacts, model.n_beads - 1)
-    beads = _numbers("beads", beads, model.n_beads)
-    raw = integrate(
-        model,
-        velocities,
-        duration,
-        dt,
+    contacts, beads = recorded(model, contacts, beads)
+    duration = require_positive("duration", duration)
+    n_samples = math.ceil(duration / dt - 1e-9) // record_every + 1
+    warn_if_large(model, left.size, n_samples, contacts, beads)
+    arguments = dict(
+        model=model,
+        initial_velocity=velocities,
+        duration=duration,
+        dt=dt,
         record_every=record_every,
         initial_displacement=initial_displacement,
         max_energy_drift=max_energy_drift,
-        links=_links_to_record(model, contacts),
-        particles=_particles_to_record(model, beads),
+        links=links_to_record(model, contacts),
+        particles=particles_to_record(model, beads),
     )
-    return _bead_view(model, raw, left.copy(), right.copy(), contacts, beads)
-
-
-def _numbers(name: str, values, largest: int) -> tuple[int, ...] | None:
-    """Sorted distinct numbers 1..largest, or None for all."""
-    if values is None:
-        return None
-    numbers = sorted({int(x) for x in np.atleast_1d(np.asarray(values, dtype=np.int64))})
-    if numbers and not (1 <= numbers[0] and numbers[-1] <= largest):
-        raise ParameterError(f"{name} must lie in 1..{largest}, got {values!r}")
-    return tuple(numbers)
-
-
-def _links_to_record(model: ChainModel, contacts) -> np.ndarray | None:
-    if contacts is None:
-        return None
-    ends = [j for j in (model.left_striker, model.right_striker - 1) if j >= 0]
-    chosen = [model.contact_link[k - 1] for k in contacts]
-    return np.unique(np.r_[chosen, model.sensor_link, ends].astype(np.int64))
-
-
-def _particles_to_record(model: ChainModel, beads) -> np.ndarray | None:
-    if beads is None:
-        return None
-    chosen = [np.arange(model.bead_first[b - 1], model.bead_last[b - 1] + 1) for b in beads]
-    return np.concatenate([np.zeros(0, dtype=np.int64), *chosen]).astype(np.int64)
+    left, right = left.copy(), right.copy()
+    return arguments, lambda raw: _bead_view(model, raw, left, right, contacts, beads)
 
 
 def _bead_view(
@@ -317,10 +374,10 @@ def _bead_view(
         time=raw.time,
         v_left=left,
         v_right=right,
-        contact_force=raw.link_force[:, :, link_column[contact_links]],
+        contact_force=_columns(raw.link_force, link_column[contact_links]),
         end_force=end_force,
         bead_velocity=_bead_velocity(model, raw, beads),
-        sensor_force=raw.link_force[:, :, link_column[model.sensor_link]],
+        sensor_force=_columns(raw.link_force, link_column[model.sensor_link]),
         kinetic_energy=raw.energy[:, :, 0],
         potential_energy=raw.energy[:, :, 1],
         dissipated_energy=raw.energy[:, :, 2],
@@ -331,6 +388,14 @@ def _bead_view(
     )
 
 
+def _columns(record: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """``record[:, :, columns]``; the record itself when that is every column in order
+    (a long chain's record is not copied)."""
+    if columns.size == record.shape[2] and np.array_equal(columns, np.arange(columns.size)):
+        return record
+    return record[:, :, columns]
+
+
 def _bead_velocity(model: ChainModel, raw: RawTrajectory, beads) -> np.ndarray:
     """Mass-weighted mean velocity of each recorded bead, (B, S, Q) m/s, computed with
     the same reductions as a per-bead loop (so the bits do not depend on N)."""
@@ -339,8 +404,15 @@ def _bead_velocity(model: ChainModel, raw: RawTrajectory, beads) -> np.ndarray:
     column[raw.particles] = np.arange(len(raw.particles))
     masses = model.masses
     first, last = model.bead_first[numbers], model.bead_last[numbers]
-    velocity = np.empty((*raw.velocity.shape[:2], len(numbers)))
     single = np.flatnonzero(first == last)
+    if single.size == numbers.size:
+        # Whole-array operations, the bits of the loop's (0.0 + v m) / m.
+        weight = masses[first]
+        velocity = _columns(raw.velocity, column[first]) * weight
+        velocity += 0.0
+        velocity /= weight
+        return velocity
+    velocity = np.empty((*raw.velocity.shape[:2], len(numbers)))
     weighted = raw.velocity[:, :, column[first[single]]] * masses[first[single]]
     velocity[:, :, single] = weighted[..., None].sum(axis=3) / masses[first[single]]
     for i in np.flatnonzero(first != last):
@@ -348,3 +420,20 @@ def _bead_velocity(model: ChainModel, raw: RawTrajectory, beads) -> np.ndarray:
         part = raw.velocity[:, :, column[a : b + 1]] * masses[a : b + 1]
         velocity[:, :, i] = part.sum(axis=2) / masses[a : b + 1].sum()
     return velocity
+
+
+__all__ = [
+    "ALL",
+    "DEFAULT_RECORD_INTERVAL",
+    "OVERVIEW_CONTACTS",
+    "RECORD_WARNING_BYTES",
+    "STEPS_PER_CONTACT_TIME",
+    "STEPS_PER_SPRING_PERIOD",
+    "LargeRecordWarning",
+    "SimulationResult",
+    "default_record",
+    "default_time_step",
+    "felt_contacts",
+    "simulate",
+    "simulate_many",
+]

@@ -97,7 +97,8 @@ def simulation_threads(
     dt: float | None = None,
 ) -> int:
     """Cores worth giving a simulate job: one per :data:`SECONDS_PER_THREAD` of
-    estimated integration, at least 1, at most the launches and :data:`MAX_THREADS`.
+    estimated integration, at least 1, at most the 2 ``n_launches`` launches (collision
+    and reference shots share one thread pool) and :data:`MAX_THREADS`.
 
     The result does not depend on the thread count: launches are independent and
     each runs on one thread (bit-identical to a serial run).
@@ -115,7 +116,7 @@ def simulation_threads(
     n_launches = require_int("n_launches", n_launches, 1)
     duration = require_positive("duration", duration)
     work = _integration_seconds(model, n_launches, max_launch_speed, duration, dt)
-    return max(1, min(n_launches, MAX_THREADS, math.ceil(work / SECONDS_PER_THREAD)))
+    return max(1, min(2 * n_launches, MAX_THREADS, math.ceil(work / SECONDS_PER_THREAD)))
 
 
 def simulation_needs(
@@ -159,7 +160,7 @@ def simulation_needs(
     held = (BYTES_PER_BEAD_SAMPLE * model.n_particles + BYTES_PER_SAMPLE) * n_launches * samples
     memory = SAFETY * (BASE_MB + SNAKEMAKE_MB + held / 1e6)
     work = _integration_seconds(model, n_launches, max_launch_speed, duration, dt)
-    seconds = SAFETY * (STARTUP_S + work / min(threads, n_launches))
+    seconds = SAFETY * (STARTUP_S + work / min(threads, 2 * n_launches))
     return JobNeeds(
         mem_mb=int(100 * math.ceil(memory / 100)),
         runtime=max(MIN_RUNTIME_MIN, math.ceil(seconds / 60)),
