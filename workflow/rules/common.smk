@@ -25,7 +25,14 @@ from chain.pipeline.resources import simulation_needs, simulation_threads
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
 from chain.physics.lammps_engine import lammps_available
-from chain.pipeline.mechanisms import setting_label, sweep_settings
+from chain.pipeline.mechanisms import (
+    CANDIDATE_REFERENCE,
+    FRICTION_MECHANISM,
+    REFERENCE_MECHANISM,
+    candidate_variants,
+    setting_label,
+    sweep_settings,
+)
 from chain.pipeline.ablation import (
     ablation_variants,
     overrides_text,
@@ -205,6 +212,8 @@ def figure_names():
         names.append("fig_parity_ssw_vs_N")
     if config["figures"]["sweep_vs_N"]:
         names.append("fig_c_vs_N")
+    if MECHANISM_TABLES:
+        names.append("fig_ssw_mechanisms")
     return names
 
 
@@ -227,6 +236,7 @@ def final_targets(wildcards=None):
         + [f"{OUT}/article.pdf"]
         + ([f"{TABLES}/sweep.csv"] if config["figures"]["sweep_vs_N"] else [])
         + LAMMPS_TARGETS
+        + MECHANISM_TABLES
     )
 
 
@@ -363,12 +373,17 @@ MECHANISM_CONFIG = {
 SWEEP_DEFAULT = sweep_settings(config, full=False)
 SWEEP_ALL = sweep_settings(config, full=True)
 FRICTIONLESS = next(iter(SWEEP_DEFAULT))
-LAMMPS_TARGETS = (
-    [f"{TABLES}/lammps_check.csv", f"{TABLES}/ssw_mechanisms.csv"]
-    + figure("fig_ssw_mechanisms")
-    if LAMMPS
-    else []
-)
+# The candidates of the virtual experiment (ablation variants with a mechanism).
+CANDIDATES = {
+    which: (
+        candidate_variants(list(ABLATION.values()), which == "_all")
+        if VIRTUAL_RUN
+        else {}
+    )
+    for which in ("", "_all")
+}
+LAMMPS_TARGETS = [f"{TABLES}/lammps_check.csv"] if LAMMPS else []
+MECHANISM_TABLES = [f"{TABLES}/ssw_mechanisms.csv"] if LAMMPS or CANDIDATES[""] else []
 
 
 wildcard_constraints:
@@ -376,6 +391,19 @@ wildcard_constraints:
 
 
 def setting_files(which, what):
-    """Per-(setting, chain) outputs of the sweep: "" the default run's, "_all" all."""
+    """Per-(setting, chain) outputs of the sweep: "" the default run's, "_all" all;
+    none without LAMMPS."""
+    if not LAMMPS:
+        return []
     settings = SWEEP_ALL if which == "_all" else SWEEP_DEFAULT
     return [f"{OUT}/lammps/{name}_N{n}_{what}.csv" for name in settings for n in CHAINS]
+
+
+def candidates_of(which):
+    """Variant name -> [mechanism, setting] of the candidates of ssw_mechanisms<which>."""
+    return {name: list(value) for name, value in CANDIDATES[which].items()}
+
+
+def candidate_files(which, what):
+    """The candidates' ablation outputs (_fits or _ssw_fits), in candidates_of order."""
+    return [f"{OUT}/ablation/{name}_{what}.csv" for name in CANDIDATES[which]]

@@ -54,12 +54,18 @@ rule lammps_setting:
         "../scripts/lammps_setting.py"
 
 
-# The default run's settings (tables/ssw_mechanisms.csv) and the whole grid
-# (tables/ssw_mechanisms_all.csv, target `mechanisms`).
+# The default run's settings and candidates (tables/ssw_mechanisms.csv) and all of them
+# (tables/ssw_mechanisms_all.csv, target `mechanisms`): the LAMMPS rows when LAMMPS is
+# installed, the virtual experiment's candidates (ablation variants with a mechanism)
+# when the experiment is virtual.
 rule ssw_mechanisms:
     input:
-        delay_fits=lambda wildcards: setting_files(wildcards.which, "delay_fits"),
-        ssw_fits=lambda wildcards: setting_files(wildcards.which, "ssw_fits"),
+        lammps_delay_fits=lambda wildcards: setting_files(wildcards.which, "delay_fits"),
+        lammps_ssw_fits=lambda wildcards: setting_files(wildcards.which, "ssw_fits"),
+        candidate_fits=lambda wildcards: candidate_files(wildcards.which, "fits"),
+        candidate_ssw_fits=lambda wildcards: candidate_files(
+            wildcards.which, "ssw_fits"
+        ),
         lib=code("ssw_mechanisms"),
     output:
         f"{TABLES}/ssw_mechanisms{{which}}.csv",
@@ -73,7 +79,9 @@ rule ssw_mechanisms:
         ENV
     params:
         labels={name: setting_label(*pair) for name, pair in SWEEP_ALL.items()},
-        reference=FRICTIONLESS,
+        lammps_reference=FRICTIONLESS,
+        candidates=lambda wildcards: candidates_of(wildcards.which),
+        candidate_reference=CANDIDATE_REFERENCE,
     script:
         "../scripts/ssw_mechanisms.py"
 
@@ -90,7 +98,5 @@ rule fig_ssw_mechanisms:
         f"{BENCH}/figures/fig_ssw_mechanisms.tsv"
     conda:
         ENV
-    params:
-        reference=setting_label(0.0, 0.0),
     script:
         "../scripts/fig_ssw_mechanisms.py"

@@ -10,6 +10,6 @@ from chain.report.fig_ssw_mechanisms import fig_ssw_mechanisms
 from chain.report.style import save_figure
 
 log = start(snakemake)
-fig = fig_ssw_mechanisms(pd.read_csv(snakemake.input.table), snakemake.params.reference)
+fig = fig_ssw_mechanisms(pd.read_csv(snakemake.input.table))
 save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
 log.info("done")

@@ -61,7 +61,8 @@ ABLATION_COLUMNS = (
 
 def ablation_variants(config: Mapping) -> list[dict]:
     """The variants of a schema-valid config: name, description, replicates,
-    default_run, set."""
+    default_run, set, mechanism ("" unless the variant is a candidate of the mechanism
+    study, tables/ssw_mechanisms.csv)."""
     variants = config.get("ablation", {}).get("variants", [])
     return [
         {
@@ -70,6 +71,7 @@ def ablation_variants(config: Mapping) -> list[dict]:
             "replicates": int(v.get("replicates", 1)),
             "default_run": bool(v.get("default_run", False)),
             "set": dict(v.get("set") or {}),
+            "mechanism": v.get("mechanism") or "",
         }
         for v in variants
     ]
@@ -157,8 +159,18 @@ def run_variant(
     estimators: Sequence[str] = ("fit_full",),
     series: str = VIRTUAL_SERIES,
 ) -> pd.DataFrame:
+    """The delay fits of :func:`run_variant_tables` (parameters and returns as there)."""
+    return run_variant_tables(settings_per_chain, tolerance, estimators, series)[0]
+
+
+def run_variant_tables(
+    settings_per_chain: Sequence[Mapping],
+    tolerance: float | None,
+    estimators: Sequence[str] = ("fit_full",),
+    series: str = VIRTUAL_SERIES,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Run the virtual experiment on each chain, analyse it as the pipeline does, and
-    fit |Delta| against F_m.
+    fit |Delta| against F_m, and the SSW at S2 against F_m.
 
     The shots go through the measured-data path (written in the measured-trace format
     to a temporary folder and loaded back), pulses are fitted per chain, collisions are
@@ -177,29 +189,38 @@ def run_variant(
 
     Returns
     -------
-    DataFrame
+    delay_fits : DataFrame
         :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
+    ssw_fits : DataFrame
+        :func:`chain.analysis.ssw.ssw_fit_table` rows of the SSW read at S2 (behind
+        LSTW), estimator ``estimators[0]``, the same shot selection.
     """
     # Imported here: chain.apparatus pulls in the simulation core, and the pulse fits
     # scipy.signal, which the ablation table job (it only reads fits) does not need.
     from chain.analysis.pulse_rows import pulse_table
+    from chain.analysis.ssw import ssw_fit_table, ssw_table
     from chain.apparatus.measured import load_dataset
     from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 
-    pulses = []
+    pulses, traces = [], []
     with tempfile.TemporaryDirectory(prefix="ablation.") as folder:
         for i, fields in enumerate(settings_per_chain):
             settings = VirtualExperiment.from_dict(fields)
             dataset = Path(folder) / f"chain{i}"
             run_virtual_experiment(settings, dataset, series)
-            traces = load_dataset(dataset, name=series)
-            pulses.append(pulse_table(traces, estimators=tuple(estimators)))
+            traces.append(load_dataset(dataset, name=series))
+            pulses.append(pulse_table(traces[-1], estimators=tuple(estimators)))
     table = pd.concat(pulses, ignore_index=True)
     selection = None
     if tolerance is not None:
         selection = select_shots(table, tolerance, estimator=estimators[0])
     delays = delay_table(table, selection=selection)
-    return delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))
+    fits = delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))
+    ssw = pd.concat(
+        [ssw_table(t, p, selection, estimator=estimators[0]) for t, p in zip(traces, pulses)],
+        ignore_index=True,
+    )
+    return fits, ssw_fit_table(ssw[ssw["sensor"] == "S2"])
 
 
 def ablation_table(fits: Mapping[str, pd.DataFrame], overrides: Mapping[str, str]) -> pd.DataFrame:

@@ -253,7 +253,8 @@ def mechanism_rows(
     Returns
     -------
     DataFrame
-        Columns :data:`MECHANISM_COLUMNS`, one row per (setting, N); SSW/F_m is the
+        Columns :data:`MECHANISM_COLUMNS`, one row per (setting, N), the reference's
+        rows first (if it is one of ``settings``); SSW/F_m is the
         proportional slope of SSW against F_m at S2 (N/N) and its standard error, C in
         us N^(1/6).
     """
@@ -262,6 +263,7 @@ def mechanism_rows(
     ssw = pd.concat(ssw_fits, ignore_index=True).astype({"N": int})
     base = ssw[ssw["model"] == reference].set_index("N")["slope"]
     rows = []
+    ssw = ssw.assign(_first=ssw["model"] != reference).sort_values("_first", kind="stable")
     for (model, n_beads), group in ssw.groupby(["model", "N"], sort=False):
         if model not in settings:
             continue
@@ -381,3 +383,78 @@ def run_sweep_setting(
     )
     delay_fits, ssw_fits = analyse_traces(traces, estimator)
     return {"traces": traces, "runs": runs, "delay_fits": delay_fits, "ssw_fits": ssw_fits}
+
+
+#: Mechanism name of the candidates' reference row.
+REFERENCE_MECHANISM = "reference (virtual experiment as configured)"
+
+
+def candidate_rows(
+    candidates: Mapping[str, tuple[str, str]],
+    delay_fits: Mapping[str, pd.DataFrame],
+    ssw_fits: Mapping[str, pd.DataFrame],
+    reference: str,
+) -> pd.DataFrame:
+    """Rows of ``ssw_mechanisms.csv`` for the virtual-experiment candidates (ablation
+    variants with a ``mechanism``), each against the ``reference`` variant.
+
+    Parameters
+    ----------
+    candidates : mapping
+        Variant name -> (mechanism, setting label); the reference may be absent.
+    delay_fits, ssw_fits : mapping
+        Variant name -> its ``_fits.csv`` and ``_ssw_fits.csv`` (replicate 0 is used).
+    reference : str
+        Name of the reference variant (the run's virtual experiment).
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`MECHANISM_COLUMNS`: the reference first (ratio 1), then every
+        candidate in order.
+    """
+
+    def first(table: pd.DataFrame, name: str) -> pd.DataFrame:
+        if "replicate" in table:
+            table = table[table["replicate"] == 0]
+        return table.assign(model=name)
+
+    groups = {REFERENCE_MECHANISM: {reference: "as configured"}}
+    for name, (mechanism, label) in candidates.items():
+        if name != reference:
+            groups.setdefault(mechanism, {})[name] = label
+    names = [reference, *(n for n in candidates if n != reference)]
+    delays = [first(delay_fits[n], n) for n in names]
+    ssw = [first(ssw_fits[n], n) for n in names]
+    tables = [
+        mechanism_rows(mechanism, settings, delays, ssw, reference)
+        for mechanism, settings in groups.items()
+    ]
+    return pd.concat(tables, ignore_index=True)
+
+
+#: The ablation variant the candidates are compared with (config ``ablation.variants``).
+CANDIDATE_REFERENCE = "mechanism_reference"
+
+
+def candidate_variants(variants: Sequence[Mapping], full: bool) -> dict[str, tuple[str, str]]:
+    """Variant name -> (mechanism, setting label) of the candidates of the mechanism
+    study: the ablation variants with a ``mechanism`` (those of the default run, or all
+    with ``full``), and :data:`CANDIDATE_REFERENCE` first; empty without it.
+
+    Parameters
+    ----------
+    variants : sequence of mapping
+        :func:`chain.pipeline.ablation.ablation_variants`.
+    full : bool
+        All candidates (target ``mechanisms``) rather than the default run's.
+    """
+    names = {v["name"] for v in variants}
+    if CANDIDATE_REFERENCE not in names:
+        return {}
+    chosen = {CANDIDATE_REFERENCE: ("", "as configured")}
+    for v in variants:
+        if v["mechanism"] and (full or v["default_run"]):
+            label = "; ".join(f"{k}={x}" for k, x in v["set"].items()) or "none"
+            chosen[v["name"]] = (v["mechanism"], label)
+    return chosen

@@ -103,11 +103,13 @@ def findings(summary: Mapping) -> dict:
     """The SSW, ablation and C-spread findings of the run, printed, or None each.
 
     Reads the summary keys ``ssw_resolved``, ``ssw_separation``, ``ssw_parity_ratio``,
-    ``ablation`` ({verdict, rows}) and ``c_spread`` ({headline_choice, min_us_N16,
-    max_us_N16, rows}); an absent or empty key gives None.
+    ``ablation`` ({verdict, rows}), ``ssw_mechanisms`` ({verdict, rows, lammps_check})
+    and ``c_spread`` ({headline_choice, min_us_N16, max_us_N16, rows}); an absent or
+    empty key gives None.
     """
     resolved = summary.get("ssw_resolved") or None
     ablation = summary.get("ablation") or None
+    study = summary.get("ssw_mechanisms") or None
     spread = summary.get("c_spread") or None
     return {
         "ssw_resolved": table_of(resolved),
@@ -122,6 +124,13 @@ def findings(summary: Mapping) -> dict:
         "ablation": None
         if ablation is None
         else {"verdict": str(ablation.get("verdict", "")), "table": table_of(ablation.get("rows"))},
+        "mechanisms": None
+        if study is None
+        else {
+            "verdict": str(study.get("verdict", "")),
+            "table": table_of(study.get("rows")),
+            "check": table_of(study.get("lammps_check") or None),
+        },
         "c_spread": None
         if spread is None
         else {

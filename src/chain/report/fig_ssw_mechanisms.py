@@ -4,6 +4,7 @@ frictionless value, N = 25 and N = 26 (tables/ssw_mechanisms.csv)."""
 from __future__ import annotations
 
 import math
+import textwrap
 
 import matplotlib as mpl
 import pandas as pd
@@ -18,24 +19,22 @@ PERCENT = 100.0
 SIGNIFICANT_RATIO = 2.0
 
 
-def fig_ssw_mechanisms(table: pd.DataFrame, reference: str, *, ax=None) -> Figure:
+def fig_ssw_mechanisms(table: pd.DataFrame, *, ax=None) -> Figure:
     """SSW/F_m (%) with its standard error, one category per (mechanism, setting) on
-    the x axis, a marker per chain (circle N = 25, cross N = 26); per chain the value
-    of the ``reference`` setting as a dashed line and twice it as a dotted line (the
-    "significantly larger" mark). A point without a value is written as "n/r" (no SSW
-    measured at S2).
+    the x axis, a marker per chain (circle N = 25, cross N = 26); at each category, per
+    chain, the value of that mechanism's reference (the frictionless LAMMPS chain, or
+    the virtual experiment as configured) as a dash and twice it (the mark of
+    "significantly larger") as a dotted dash. A point without a value is written "n/r".
 
     Parameters
     ----------
     table : DataFrame
         ``ssw_mechanisms.csv`` (:func:`chain.pipeline.mechanisms.mechanism_rows`).
-    reference : str
-        The ``setting`` of the frictionless reference.
     ax : Axes, optional
         Draw here instead of on a new figure.
     """
     own = ax is None
-    fig, ax = axes_or_new(ax, 7.2, 4.2)
+    fig, ax = axes_or_new(ax, 7.6, 4.6)
     cases = list(dict.fromkeys(zip(table["mechanism"], table["setting"])))
     position = {case: i for i, case in enumerate(cases)}
     chains = sorted(int(n) for n in table["N"].unique())
@@ -43,21 +42,66 @@ def fig_ssw_mechanisms(table: pd.DataFrame, reference: str, *, ax=None) -> Figur
         for k, n_beads in enumerate(chains):
             rows = table[table["N"] == n_beads]
             shift = 0.15 * (k - (len(chains) - 1) / 2)
+            _draw_references(ax, rows, position, shift, n_beads, k)
             _draw_chain(ax, rows, position, shift, n_beads, chain_marker(n_beads, chains))
-            base = rows[rows["setting"] == reference]["ssw_over_Fm"]
-            if len(base) and math.isfinite(float(base.iloc[0])):
-                value = PERCENT * float(base.iloc[0])
-                style = {"color": "0.35" if k else "0.6", "lw": 0.8}
-                ax.axhline(value, ls="--", label=f"N = {n_beads} frictionless", **style)
-                ax.axhline(SIGNIFICANT_RATIO * value, ls=":", label=f"N = {n_beads}: 2 x", **style)
+        _draw_groups(ax, cases, position)
         ax.set_xticks(range(len(cases)))
-        ax.set_xticklabels([s for _, s in cases], rotation=40, ha="right", fontsize=7)
+        ax.set_xticklabels(
+            [s.replace("; ", "\n").replace(", ", "\n") for _, s in cases], fontsize=5.5
+        )
         ax.set_xlim(-0.5, len(cases) - 0.5)
         ax.set_ylim(bottom=0)
         ax.set_ylabel("SSW / F$_m$ at S2 (%)")
-        ax.set_title("Secondary-wave size per mechanism (models, not data)", loc="left", fontsize=9)
+        ax.set_title("Secondary-wave size per mechanism (models, not data)", loc="left", pad=16)
         add_legend(fig, ax, own, "upper left")
     return fig
+
+
+def _draw_references(ax, rows: pd.DataFrame, position: dict, shift, n_beads, k) -> None:
+    """Per category, the reference value (SSW/F_m over the ratio) and twice it."""
+    color = ("0.55", "0.2")[k % 2]
+    for number, row in enumerate(rows.itertuples(index=False)):
+        reference = row.ssw_over_Fm / row.ratio_to_frictionless
+        if not math.isfinite(reference):
+            continue
+        x = position[(row.mechanism, row.setting)] + shift
+        first = number == 0
+        ax.hlines(
+            PERCENT * reference,
+            x - 0.12,
+            x + 0.12,
+            colors=color,
+            lw=1.0,
+            ls="--",
+            label=f"N = {n_beads}: reference" if first else None,
+        )
+        ax.hlines(
+            SIGNIFICANT_RATIO * PERCENT * reference,
+            x - 0.12,
+            x + 0.12,
+            colors=color,
+            lw=1.0,
+            ls=":",
+            label=f"N = {n_beads}: 2 x reference" if first else None,
+        )
+
+
+def _draw_groups(ax, cases: list, position: dict) -> None:
+    """Alternating bands and a title over the settings of each mechanism."""
+    for number, mechanism in enumerate(dict.fromkeys(m for m, _ in cases)):
+        members = [position[c] for c in cases if c[0] == mechanism]
+        lo, hi = min(members) - 0.5, max(members) + 0.5
+        ax.axvspan(lo, hi, color="0.94" if number % 2 else "white", zorder=0)
+        width = max(8, int(16 * (hi - lo)))
+        ax.text(
+            (lo + hi) / 2,
+            1.01,
+            textwrap.fill(mechanism, width),
+            transform=ax.get_xaxis_transform(),
+            ha="center",
+            va="bottom",
+            fontsize=5.5,
+        )
 
 
 def _draw_chain(ax, rows: pd.DataFrame, position: dict, shift: float, n_beads, marker) -> None:
@@ -75,14 +119,15 @@ def _draw_chain(ax, rows: pd.DataFrame, position: dict, shift: float, n_beads, m
         capsize=2,
         label=f"N = {n_beads}",
     )
+    # "n/r" of the two chains one above the other.
     for xi, value in zip(x, rows["ssw_over_Fm"]):
         if not math.isfinite(float(value)):
             ax.text(
                 xi,
-                0.02,
+                0.02 + 0.05 * (marker == "x"),
                 "n/r",
                 transform=ax.get_xaxis_transform(),
                 ha="center",
-                fontsize=6,
+                fontsize=5,
                 color="0.4",
             )
