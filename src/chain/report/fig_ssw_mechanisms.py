@@ -15,13 +15,16 @@ from chain.report.style import STYLE, add_legend, axes_or_new, chain_marker
 #: Percent per unit ratio.
 PERCENT = 100.0
 
+#: Colour of the first and second chain (markers and reference dashes).
+CHAIN_COLORS = ("#1f77b4", "#d95f02")
+
 #: A ratio to the frictionless value that counts as "significantly larger" (issue 24).
 SIGNIFICANT_RATIO = 2.0
 
 
 def fig_ssw_mechanisms(table: pd.DataFrame, *, ax=None) -> Figure:
     """SSW/F_m (%) with its standard error, one category per (mechanism, setting) on
-    the x axis, a marker per chain (circle N = 25, cross N = 26); at each category, per
+    the x axis, a marker and colour per chain (circle N = 25, cross N = 26); at each category, per
     chain, the value of that mechanism's reference (the frictionless LAMMPS chain, or
     the virtual experiment as configured) as a dash and twice it (the mark of
     "significantly larger") as a dotted dash. A point without a value is written "n/r".
@@ -43,23 +46,28 @@ def fig_ssw_mechanisms(table: pd.DataFrame, *, ax=None) -> Figure:
             rows = table[table["N"] == n_beads]
             shift = 0.15 * (k - (len(chains) - 1) / 2)
             _draw_references(ax, rows, position, shift, n_beads, k)
-            _draw_chain(ax, rows, position, shift, n_beads, chain_marker(n_beads, chains))
+            marker = chain_marker(n_beads, chains)
+            _draw_chain(ax, rows, position, shift, n_beads, marker, CHAIN_COLORS[k % 2])
         _draw_groups(ax, cases, position)
         ax.set_xticks(range(len(cases)))
-        ax.set_xticklabels(
-            [s.replace("; ", "\n").replace(", ", "\n") for _, s in cases], fontsize=5.5
-        )
+        ax.set_xticklabels([_tick(setting) for _, setting in cases], fontsize=5.5)
         ax.set_xlim(-0.5, len(cases) - 0.5)
         ax.set_ylim(bottom=0)
         ax.set_ylabel("SSW / F$_m$ at S2 (%)")
-        ax.set_title("Secondary-wave size per mechanism (models, not data)", loc="left", pad=16)
+        ax.set_title("Secondary-wave size per mechanism (models, not data)", loc="left", pad=38)
         add_legend(fig, ax, own, "upper left")
     return fig
 
 
+def _tick(setting: str) -> str:
+    """A setting label on short lines: one per override, long ones broken after "="."""
+    parts = setting.replace(", ", "; ").split("; ")
+    return "\n".join(p.replace("=", "=\n") if len(p) > 14 else p for p in parts)
+
+
 def _draw_references(ax, rows: pd.DataFrame, position: dict, shift, n_beads, k) -> None:
     """Per category, the reference value (SSW/F_m over the ratio) and twice it."""
-    color = ("0.55", "0.2")[k % 2]
+    color = CHAIN_COLORS[k % 2]
     for number, row in enumerate(rows.itertuples(index=False)):
         reference = row.ssw_over_Fm / row.ratio_to_frictionless
         if not math.isfinite(reference):
@@ -104,7 +112,7 @@ def _draw_groups(ax, cases: list, position: dict) -> None:
         )
 
 
-def _draw_chain(ax, rows: pd.DataFrame, position: dict, shift: float, n_beads, marker) -> None:
+def _draw_chain(ax, rows: pd.DataFrame, position: dict, shift, n_beads, marker, color) -> None:
     """One chain's points with error bars; "n/r" where the table has no value."""
     x = [position[c] + shift for c in zip(rows["mechanism"], rows["setting"])]
     ax.errorbar(
@@ -115,7 +123,7 @@ def _draw_chain(ax, rows: pd.DataFrame, position: dict, shift: float, n_beads, m
         marker=marker,
         ms=5,
         mfc="none",
-        color="black",
+        color=color,
         capsize=2,
         label=f"N = {n_beads}",
     )
@@ -129,5 +137,5 @@ def _draw_chain(ax, rows: pd.DataFrame, position: dict, shift: float, n_beads, m
                 transform=ax.get_xaxis_transform(),
                 ha="center",
                 fontsize=5,
-                color="0.4",
+                color=color,
             )
