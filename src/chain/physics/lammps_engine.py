@@ -10,6 +10,8 @@ barely touching, with ``pair_style granular``:
   (3/2) eta kappa delta^(1/2) d(delta)/dt = 2 eta E* a d(delta)/dt, so
   eta_n0 = 2 eta E* / m* (:func:`viscoelastic_damping_coefficient`), exactly, for
   every overlap; ``limit_damping`` clips the total at zero as our kernel does;
+* or, instead, ``damping velocity``: a viscous force gamma d(delta)/dt in every closed
+  contact (Rosas and Romero's dissipation), ``GranularChain.viscous_damping``;
 * ``tangential mindlin`` with the bead-bead friction coefficient mu_b, ``rolling sds``
   and ``twisting marshall`` (rotation and its resistances);
 * the track: a flat floor under the beads (``fix wall/gran``, the same contact model,
@@ -172,6 +174,10 @@ class GranularChain:
         frictionless 1D limit of the cross-check).
     gravity : float
         Acceleration of gravity, m/s^2 (with ``track``).
+    viscous_damping : float
+        A viscous inter-bead force gamma d(delta)/dt in every closed contact instead of
+        the Kuwabara-Kono term (``damping velocity``; Rosas and Romero's dissipation),
+        N s/m; 0: Kuwabara-Kono with ``eta``. Not both.
     """
 
     n_beads: int
@@ -184,13 +190,16 @@ class GranularChain:
     track_friction: float = 0.0
     track: bool = False
     gravity: float = 9.81
+    viscous_damping: float = 0.0
 
     def __post_init__(self) -> None:
         require_int("n_beads", self.n_beads, 2)
         for name in ("radius", "youngs_modulus", "density", "gravity"):
             require_positive(name, getattr(self, name))
-        for name in ("eta", "bead_friction", "track_friction"):
+        for name in ("eta", "bead_friction", "track_friction", "viscous_damping"):
             require_nonnegative(name, getattr(self, name))
+        if self.eta > 0 and self.viscous_damping > 0:
+            raise ParameterError("give eta (Kuwabara-Kono) or viscous_damping, not both")
         if not 0.0 <= self.poisson_ratio < 0.5:
             raise ParameterError(f"poisson_ratio must be in [0, 0.5), got {self.poisson_ratio}")
 
@@ -289,12 +298,18 @@ def run_granular_chain(
 def _contact_model(chain: GranularChain, friction: float, reduced_mass: float) -> str:
     """The granular model words of a contact with Coulomb ``friction`` and LAMMPS'
     damping coefficient for ``reduced_mass`` (kg)."""
-    damping = viscoelastic_damping_coefficient(
-        chain.eta, chain.youngs_modulus, chain.poisson_ratio, reduced_mass
+    style, damping = (
+        "viscoelastic",
+        viscoelastic_damping_coefficient(
+            chain.eta, chain.youngs_modulus, chain.poisson_ratio, reduced_mass
+        ),
     )
+    if chain.viscous_damping > 0:
+        # LAMMPS' velocity damping: F_d = eta_n0 d(delta)/dt, eta_n0 in N s/m.
+        style, damping = "velocity", chain.viscous_damping
     words = [
         f"hertz/material {chain.youngs_modulus!r} {damping!r} {chain.poisson_ratio!r}",
-        f"damping viscoelastic tangential mindlin NULL 1.0 {float(friction)!r}",
+        f"damping {style} tangential mindlin NULL 1.0 {float(friction)!r}",
     ]
     if friction > 0:
         words.append(

@@ -44,6 +44,10 @@ MECHANISM_COLUMNS = (
 #: Mechanism name of the LAMMPS friction/rotation rows.
 FRICTION_MECHANISM = "rotation + friction (LAMMPS)"
 
+#: Mechanism name of the LAMMPS rows with a viscous inter-bead force instead of
+#: Kuwabara-Kono (on the frictionless track).
+VISCOUS_MECHANISM = "viscous inter-bead term (LAMMPS)"
+
 #: Columns of ``tables/lammps_check.csv``.
 CHECK_COLUMNS = (
     "N",
@@ -80,6 +84,8 @@ SWEEP_DEFAULTS = {
     "track_friction": [0.0, 0.1, 0.3, 0.5],
     "bead_friction": [0.0, 0.1, 0.3],
     "default_settings": [[0.0, 0.0], [0.3, 0.0], [0.3, 0.3], [0.5, 0.3]],
+    "viscous_N_s_per_m": [2.0, 10.0, 30.0],
+    "default_viscous_N_s_per_m": [10.0],
 }
 
 
@@ -114,6 +120,21 @@ def sweep_settings(config: Mapping, full: bool) -> dict[str, tuple[float, float]
     return {setting_name(t, b): (t, b) for t, b in dict.fromkeys(pairs)}
 
 
+def viscous_name(gamma: float) -> str:
+    """File-safe name of a viscous setting of gamma N s/m, e.g. ``visc2p0``."""
+    return "visc" + f"{gamma:g}".replace(".", "p")
+
+
+def viscous_settings(config: Mapping, full: bool) -> dict[str, float]:
+    """Name -> gamma (N s/m) of the viscous inter-bead settings: the default run's or,
+    with ``full``, those and the full list."""
+    sweep = lammps_options(config)["sweep"]
+    values = list(sweep["default_viscous_N_s_per_m"])
+    if full:
+        values += list(sweep["viscous_N_s_per_m"])
+    return {viscous_name(float(g)): float(g) for g in dict.fromkeys(values)}
+
+
 def granular_chain(
     config: Mapping,
     n_beads: int,
@@ -122,6 +143,7 @@ def granular_chain(
     track_friction: float = 0.0,
     bead_friction: float = 0.0,
     track: bool = False,
+    viscous_damping: float = 0.0,
 ) -> GranularChain:
     """The configured beads (material, radius) as a LAMMPS chain.
 
@@ -137,6 +159,8 @@ def granular_chain(
         mu_t and mu_b.
     track : bool
         Floor and gravity (``lammps.sweep.gravity_m_s2``); False for the 1D limit.
+    viscous_damping : float
+        gamma of a viscous inter-bead force instead of Kuwabara-Kono, N s/m.
     """
     material = get_material(config["material"])
     return GranularChain(
@@ -150,6 +174,7 @@ def granular_chain(
         track_friction=float(track_friction),
         track=bool(track),
         gravity=float(lammps_options(config)["sweep"]["gravity_m_s2"]),
+        viscous_damping=float(viscous_damping),
     )
 
 
@@ -350,7 +375,9 @@ def run_sweep_setting(
     sensors : sequence of int
         [S1, S2].
     name : str
-        A name of :func:`sweep_settings` (full grid); it is the traces' ``model``.
+        A name of :func:`sweep_settings` or :func:`viscous_settings` (full lists); it is
+        the traces' ``model``. Viscous settings run on the frictionless track with the
+        viscous force instead of Kuwabara-Kono.
     estimator : str
         Pulse estimator.
 
@@ -362,16 +389,20 @@ def run_sweep_setting(
     """
     from chain.apparatus.lammps_shots import lammps_shots
 
-    track_friction, bead_friction = sweep_settings(config, full=True)[name]
     options = lammps_options(config)
-    chain = granular_chain(
-        config,
-        n_beads,
-        eta=options["sweep"]["eta_s"],
-        track_friction=track_friction,
-        bead_friction=bead_friction,
-        track=True,
-    )
+    viscous = viscous_settings(config, full=True)
+    if name in viscous:
+        chain = granular_chain(config, n_beads, eta=0.0, track=True, viscous_damping=viscous[name])
+    else:
+        track_friction, bead_friction = sweep_settings(config, full=True)[name]
+        chain = granular_chain(
+            config,
+            n_beads,
+            eta=options["sweep"]["eta_s"],
+            track_friction=track_friction,
+            bead_friction=bead_friction,
+            track=True,
+        )
     traces, runs = lammps_shots(
         chain,
         options["sweep"]["launch_speeds_m_s"],
