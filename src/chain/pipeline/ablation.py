@@ -159,22 +159,8 @@ def run_variant(
     estimators: Sequence[str] = ("fit_full",),
     series: str = VIRTUAL_SERIES,
 ) -> pd.DataFrame:
-    """The delay fits of :func:`run_variant_tables` (parameters and returns as there)."""
-    return run_variant_tables(settings_per_chain, tolerance, estimators, series)[0]
-
-
-def run_variant_tables(
-    settings_per_chain: Sequence[Mapping],
-    tolerance: float | None,
-    estimators: Sequence[str] = ("fit_full",),
-    series: str = VIRTUAL_SERIES,
-) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Run the virtual experiment on each chain, analyse it as the pipeline does, and
-    fit |Delta| against F_m, and the SSW at S2 against F_m.
-
-    The shots go through the measured-data path (written in the measured-trace format
-    to a temporary folder and loaded back), pulses are fitted per chain, collisions are
-    selected with ``tolerance`` and the delays fitted pooled and per chain.
+    fit |Delta| against F_m (:func:`run_variant_shots`, then :func:`variant_delay_fits`).
 
     Parameters
     ----------
@@ -189,16 +175,38 @@ def run_variant_tables(
 
     Returns
     -------
-    delay_fits : DataFrame
+    DataFrame
         :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
-    ssw_fits : DataFrame
-        :func:`chain.analysis.ssw.ssw_fit_table` rows of the SSW read at S2 (behind
-        LSTW), estimator ``estimators[0]``, the same shot selection.
+    """
+    _, pulses, selection = run_variant_shots(settings_per_chain, tolerance, estimators, series)
+    return variant_delay_fits(pulses, selection)
+
+
+def run_variant_shots(
+    settings_per_chain: Sequence[Mapping],
+    tolerance: float | None,
+    estimators: Sequence[str] = ("fit_full",),
+    series: str = VIRTUAL_SERIES,
+) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
+    """Run the virtual experiment on each chain and fit its pulses and select its shots
+    as the pipeline does (parameters as :func:`run_variant`).
+
+    The shots go through the measured-data path (written in the measured-trace format
+    to a temporary folder and loaded back), pulses are fitted per chain and collisions
+    are selected with ``tolerance``.
+
+    Returns
+    -------
+    traces : list of DataFrame
+        The trace table of each chain.
+    pulses : DataFrame
+        Their pulse rows (:func:`chain.analysis.pulse_rows.pulse_table`).
+    selection : DataFrame or None
+        The shot selection (None with ``tolerance`` None).
     """
     # Imported here: chain.apparatus pulls in the simulation core, and the pulse fits
     # scipy.signal, which the ablation table job (it only reads fits) does not need.
     from chain.analysis.pulse_rows import pulse_table
-    from chain.analysis.ssw import ssw_fit_table, ssw_table
     from chain.apparatus.measured import load_dataset
     from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 
@@ -214,13 +222,14 @@ def run_variant_tables(
     selection = None
     if tolerance is not None:
         selection = select_shots(table, tolerance, estimator=estimators[0])
-    delays = delay_table(table, selection=selection)
-    fits = delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))
-    ssw = pd.concat(
-        [ssw_table(t, p, selection, estimator=estimators[0]) for t, p in zip(traces, pulses)],
-        ignore_index=True,
-    )
-    return fits, ssw_fit_table(ssw[ssw["sensor"] == "S2"])
+    return traces, table, selection
+
+
+def variant_delay_fits(pulses: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
+    """|Delta| = C F_m^(-1/6) and the free power law, pooled and per chain, of the pulses
+    of :func:`run_variant_shots` (:func:`chain.analysis.delays.delay_fit_table` rows)."""
+    delays = delay_table(pulses, selection=selection)
+    return delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))
 
 
 def ablation_table(fits: Mapping[str, pd.DataFrame], overrides: Mapping[str, str]) -> pd.DataFrame:
