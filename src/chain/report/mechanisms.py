@@ -73,7 +73,7 @@ def candidate_sentence(table: pd.DataFrame, friction: str, reference: str) -> st
         return "No other candidate was run (the run has no virtual experiment)"
     mean = rows.groupby(["mechanism", "setting"], sort=False)["ratio_to_frictionless"].mean()
     if not mean.notna().any():
-        return "No candidate has an SSW value at S2"
+        return "No candidate can be compared with its reference (no SSW value at S2 in both)"
     mechanism, setting = mean.astype(float).idxmax()
     chosen = rows[(rows["mechanism"] == mechanism) & (rows["setting"] == setting)]
     base = table[table["mechanism"] == reference]
