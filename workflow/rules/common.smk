@@ -320,15 +320,14 @@ ABLATION = {v["name"]: v for v in ablation_variants(config)}
 # tables/ablation_exponent.csv and the summary; `snakemake ablation` runs them all into
 # tables/ablation_exponent_all.csv. Only with the virtual experiment.
 VIRTUAL_RUN = config["experiment"]["source"] == "virtual"
-# Variants that name a mechanism belong to the mechanism study (config mechanism_study).
+# Variants that name a mechanism (and their reference) belong to the mechanism study
+# (config mechanism_study; tables/ssw_mechanisms.csv), not to this table's verdict.
 STUDY = config.get("mechanism_study", True)
 ABLATION_DEFAULT = (
     [
         n
         for n, v in ABLATION.items()
-        if v["default_run"]
-        and (STUDY or not v["mechanism"])
-        and (STUDY or n != CANDIDATE_REFERENCE)
+        if v["default_run"] and not v["mechanism"] and n != CANDIDATE_REFERENCE
     ]
     if VIRTUAL_RUN
     else []
