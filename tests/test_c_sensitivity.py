@@ -106,7 +106,8 @@ def test_ablation_verdict_names_the_numbers():
             "exponent_stderr": [0.010, 0.005],
         }
     )
-    verdict = ablation_summary(ablation, fits, "fit_full")["verdict"]
+    # Printed with the minus sign U+2212 (chain.report.printed); compared as ASCII.
+    verdict = ablation_summary(ablation, fits, "fit_full")["verdict"].replace("\u2212", "-")
     for number in ("-0.214", "-0.169", "-0.154", "viscoelastic -0.152"):
         assert number in verdict
     missing = ablation_summary(ablation.iloc[:1], fits, "fit_full")["verdict"]

@@ -369,6 +369,16 @@ BAD_CONFIGS = {
         key("chains[1].N"),
         "N = 25 is listed twice (also chains[0]); allowed: each N once",
     ),
+    "long chain not a chain": (
+        setter("long_chains", "N", value=[26, 121]),
+        key("long_chains.N[0]"),
+        "N = 26 is also chains[1] (their files would clash)",
+    ),
+    "long chain long enough": (
+        setter("long_chains", "N", value=[2]),
+        on("long_chains", "N", 0),
+        "less than the minimum of 3",
+    ),
     "unique model names": (
         setter("models", 1, "name", value="elastic"),
         key("models[1].name"),

@@ -195,14 +195,24 @@ def ssw_tables():
                         "N": n,
                         "F_m_N": force,
                         "ssw_N": slope * force,
+                        "ssw_err_N": 0.1 * slope * force,
+                        "ssw_sys_N": 0.1 * slope * force,
                         "method": "residual",
                         "ok": True,
+                        "resolved": n == 26,
+                        "upper_limit": False,
                     }
                 )
     ssw = pd.DataFrame(rows)
     fits = ssw.groupby(["source", "model", "N"], as_index=False).apply(
         lambda g: pd.Series(
-            {"slope": (g.ssw_N / g.F_m_N).mean(), "slope_stderr": 1e-4, "n_points": len(g)}
+            {
+                "slope": (g.ssw_N / g.F_m_N).mean(),
+                "slope_stderr": 1e-4,
+                "slope_stat": 1e-4,
+                "slope_sys": 2e-3,
+                "n_points": len(g),
+            }
         ),
         include_groups=False,
     )
@@ -368,7 +378,8 @@ def test_fig4_lines_fits_and_references():
         label.startswith("fit to virtual experiment (model), N pooled: C = 46.0 ± 0.6")
         for label in labels
     )
-    assert any("fit to simulation, elastic: C = 40.0 ± 0.2" in label for label in labels)
+    # An error of 0.2 keeps two figures (leading digits 10-35, chain.report.printed).
+    assert any("fit to simulation, elastic: C = 40.00 ± 0.20" in label for label in labels)
     assert any("Eq. 6 as printed" in label and "49.75" in label for label in labels)
     assert any("exact Hertz" in label and "37.74" in label for label in labels)
     assert any("paper's experimental fit" in label and "45.9 ± 0.5" in label for label in labels)
@@ -402,14 +413,13 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     ssw, fits = ssw_tables()
     ssw.loc[0, "ok"] = False
     ssw.loc[1, "ssw_N"] = math.nan
-    ssw.loc[2, "ssw_N"] = -0.1  # below the noise: not on a log axis
+    ssw.loc[2, ["ssw_N", "upper_limit"]] = (-0.1, True)  # an upper limit: drawn at value + error
     caplog.clear()
     with caplog.at_level("INFO", logger="chain.analysis.rows"):
         fig = fig5_ssw_vs_force(ssw, fits)
-    points = [line for line in fig.get_axes()[0].get_lines() if line.get_linestyle() == "None"]
-    assert sum(len(line.get_xdata()) for line in points) == len(ssw) - 3
-    assert "Fig. 5 SSW rows: 3 of 16 left out (1 flagged ok = False, 1 ok but NaN" in caplog.text
-    assert "1 <= 0 on a log axis" in caplog.text
+    points = [container.lines[0] for container in fig.get_axes()[0].containers]
+    assert sum(len(line.get_xdata()) for line in points) == len(ssw) - 2
+    assert "Fig. 5 SSW rows: 2 of 16 left out (1 flagged ok = False, 1 ok but NaN" in caplog.text
 
 
 def test_fig4_on_given_axes():
@@ -419,17 +429,54 @@ def test_fig4_on_given_axes():
     assert ax.get_legend() is not None and not fig.legends
 
 
-def test_fig5_filled_simulation_open_experiment():
+def test_fig5_resolved_filled_measured_open_upper_limits_arrowed():
     ssw, fits = ssw_tables()
+    limits = (ssw["N"] == 25) & (ssw["source"] == "experiment")
+    ssw.loc[limits, "upper_limit"] = True
     fig = fig5_ssw_vs_force(ssw, fits, experiment_label="virtual experiment (model)")
     ax = fig.get_axes()[0]
-    points = {line.get_label(): line for line in ax.get_lines() if line.get_linestyle() == "None"}
-    sim = points[next(k for k in points if k.startswith("simulation, elastic, N = 25"))]
-    exp = points[next(k for k in points if k.startswith("virtual experiment (model), N = 26"))]
-    assert sim.get_markerfacecolor() != "none"
-    assert exp.get_markerfacecolor() == "none"
-    assert "slope 5.00e-02" in exp.get_label()
+    drawn = [container.lines[0] for container in ax.containers]
+    filled = [line for line in drawn if line.get_markerfacecolor() not in ("white", "none")]
+    # Resolved (N = 26, both series) filled; the rest open.
+    assert sum(len(line.get_xdata()) for line in filled) == int(ssw["resolved"].sum())
+    # Upper limits are drawn at value + error, with arrows (caps of the error bars).
+    level = (ssw.loc[limits, "ssw_N"] + ssw.loc[limits, "ssw_err_N"]).to_numpy()
+    assert any(
+        len(line.get_ydata()) == len(level)
+        and np.allclose(np.sort(line.get_ydata()), np.sort(level))
+        for line in drawn
+    )
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    label = next(t for t in labels if t.startswith("virtual experiment (model), N = 26"))
+    assert (
+        "5.00 ± 0.01 (stat) ± 0.20 (sys)" in label
+        and f"{len(FORCES_N)} of {len(FORCES_N)} resolved" in label
+    )
     assert ax.get_ylabel() == "SSW amplitude (N)"
+
+
+def test_fig5_panel_b_from_the_track():
+    ssw, fits = ssw_tables()
+    track = pd.DataFrame(
+        {
+            "model": "elastic",
+            "N": 26,
+            "wave": "LSTW",
+            "distance_beads": [3.0, 4.0, 5.0],
+            "force_N": [np.nan, 2.0, 1.8],
+            "F_m_N": 100.0,
+            "separated": [False, True, True],
+        }
+    )
+    speed = pd.DataFrame({"model": ["elastic"], "wave": ["LSTW"], "distance_beads": [4.0]})
+    fig = fig5_ssw_vs_force(ssw, fits, track, speed, sensor_distances={26: 3.5})
+    ax = fig.get_axes()[1]
+    points = [line for line in ax.get_lines() if line.get_label() == "elastic, N = 26"]
+    np.testing.assert_allclose(points[0].get_ydata(), [0.02, 0.018])
+    dotted = [
+        line for line in ax.get_lines() if line.get_linestyle() == ":" and len(line.get_xdata())
+    ]
+    assert [line.get_xdata()[0] for line in dotted] == [4.0]
 
 
 def test_parity_figure():
@@ -509,21 +556,21 @@ def test_fig3_says_when_the_ssw_is_not_resolved(trace_inputs):
     assert not any("SSW" in t.get_text() for t in fig.legends[0].get_texts())
 
 
-def test_fig5_series_without_resolved_points_says_so_in_the_legend():
+def test_fig5_series_without_measurable_points_says_so_in_the_legend():
     ssw, fits = ssw_tables()
     gone = (ssw["source"] == "simulation") & (ssw["N"] == 26)
     ssw.loc[gone, "ok"] = False
     fig = fig5_ssw_vs_force(ssw, fits)
-    labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    empty = [label for label in labels if "not resolved" in label]
-    assert empty and all("N = 26" in label and "(0 of" in label for label in empty)
     ax = fig.get_axes()[0]
-    drawn = sum(len(line.get_xdata()) for line in ax.get_lines() if line.get_marker() != "None")
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    empty = [label for label in labels if "no measurable SSW" in label]
+    assert empty and all("N = 26" in label and "(0 of" in label for label in empty)
+    drawn = sum(len(container.lines[0].get_xdata()) for container in ax.containers)
     assert drawn == int((~gone).sum())
-    # Nothing resolved anywhere: empty axes that say so.
+    # Nothing measurable anywhere: axes that say so.
     ssw["ok"] = False
     fig = fig5_ssw_vs_force(ssw, fits)
-    assert any("not resolved" in t.get_text() for t in fig.get_axes()[0].texts)
+    assert any("no measurable SSW" in t.get_text() for t in fig.get_axes()[0].texts)
 
 
 def test_parity_figure_without_any_resolved_ssw_says_so():

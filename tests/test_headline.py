@@ -47,6 +47,7 @@ def _summary() -> dict:
         "ssw_resolved": [],
         "ssw_separation": [],
         "ssw_parity_ratio": [],
+        "ssw_far_field": [],
     }
 
 

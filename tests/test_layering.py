@@ -133,3 +133,56 @@ def test_scripts_import_concrete_modules():
         if isinstance(node, ast.ImportFrom) and node.module in ("chain", "chain.physics")
     ]
     assert not wrong, wrong
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Module -> the chain modules it imports (anywhere in the file, deferred imports
+    included: a deferred import only hides a cycle)."""
+    return {
+        module: {name for name in imports(path) if name in MODULES and name != module}
+        for module, path in MODULES.items()
+    }
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The import cycles of ``graph``: one per strongly connected component of more than
+    one module (Tarjan's algorithm), its modules sorted."""
+    index, low, stack, on_stack, found = {}, {}, [], set(), []
+
+    def visit(node):
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for target in sorted(graph.get(node, ())):
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                top = stack.pop()
+                on_stack.discard(top)
+                component.append(top)
+                if top == node:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return found
+
+
+def test_no_import_cycles():
+    """No two chain modules import each other, directly or round a loop."""
+    assert cycles(import_graph()) == []
+
+
+def test_the_cycle_check_finds_a_loop():
+    """The test itself: a three-module loop is found, a chain of imports is not."""
+    loop = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
+    assert cycles(loop) == [["a", "b", "c"]]
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == []

@@ -7,7 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from chain.analysis.regression import fit_fixed_exponent, fit_power_law, fit_proportional
+from chain.analysis.regression import (
+    fit_fixed_exponent,
+    fit_power_law,
+    fit_proportional,
+    ratio_with_error,
+)
 
 # Delta = C F_m^(-1/6) over the paper's range of forces.
 C_TRUE = 45.9  # us N^(1/6)
@@ -117,3 +122,18 @@ def test_bad_input_raises():
         fit_power_law([1.0, 2.0, 3.0], [1.0, -1.0, 1.0])
     with pytest.raises(ValueError):
         fit_proportional([1.0, np.nan], [1.0, 2.0])
+
+
+def test_ratio_error_propagates_relative_errors_and_matches_sampling():
+    """top / bottom with relative errors in quadrature: 6 ± 0.3 over 2 ± 0.1 is 3 with a
+    relative error sqrt(2) x 5 %; a Monte-Carlo draw agrees (small errors: linear regime);
+    a zero or NaN denominator gives NaN."""
+    found = ratio_with_error(6.0, 0.3, 2.0, 0.1)
+    assert found["ratio"] == 3.0
+    assert found["ratio_err"] == pytest.approx(3.0 * 0.05 * np.sqrt(2.0))
+    rng = np.random.default_rng(1)
+    draws = rng.normal(6.0, 0.03, 200_000) / rng.normal(2.0, 0.01, 200_000)
+    small = ratio_with_error(6.0, 0.03, 2.0, 0.01)
+    assert np.std(draws) == pytest.approx(small["ratio_err"], rel=0.01)
+    assert np.isnan(ratio_with_error(1.0, 0.1, 0.0, 0.1)["ratio"])
+    assert np.isnan(ratio_with_error(1.0, 0.1, float("nan"), 0.1)["ratio_err"])

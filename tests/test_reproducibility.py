@@ -775,10 +775,13 @@ def test_fits_ignore_flagged_rows_and_refuse_nan_in_ok_rows():
             "method": "residual",
             "F_m_N": forces,
             "ssw_N": 0.04 * forces,
+            "ssw_err_N": 0.004 * forces,
+            "ssw_sys_N": 0.002 * forces,
+            "resolved": True,
             "ok": True,
         }
     )
-    junk = ssw.iloc[:2].assign(ok=False, ssw_N=[np.nan, 1e6])
+    junk = ssw.iloc[:2].assign(ok=False, ssw_N=[np.nan, 1e6], ssw_err_N=[np.nan, 0.0])
     pd.testing.assert_frame_equal(
         ssw_fit_table(pd.concat([ssw, junk], ignore_index=True)), ssw_fit_table(ssw)
     )

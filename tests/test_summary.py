@@ -56,7 +56,10 @@ def ssw_fits() -> pd.DataFrame:
             "N": [25, 26],
             "slope": [0.019, 0.047],
             "slope_stderr": [2e-5, 3e-5],
+            "slope_stat": [2e-5, 3e-5],
+            "slope_sys": [0.0, 0.0],
             "n_points": [24, 24],
+            "n_resolved": [0, 24],
             "method": "residual",
         }
     )
@@ -327,8 +330,8 @@ def test_no_experiment_no_selection_rows(summary):
 
 
 def test_ssw_keys_and_rows():
-    # One resolved shot of two at S2 of N = 26, none at N = 25; the track separates
-    # for N = 26 only.
+    # One resolved shot of two at S2 of N = 26, none at N = 25 (measured there, upper
+    # limits); the track separates for N = 26 only; long chains give the far field.
     ssw = pd.DataFrame(
         {
             "source": "simulation",
@@ -336,10 +339,12 @@ def test_ssw_keys_and_rows():
             "N": [25, 25, 26, 26],
             "sensor": "S2",
             "method": "residual",
-            "ok": [False, False, True, False],
-            "reason": ["not resolved at the sensor", "not resolved at the sensor", "", "x"],
+            "ok": [True, True, True, False],
+            "reason": ["", "", "", "x"],
             "F_m_N": 100.0,
-            "ssw_N": [math.nan, math.nan, 2.0, math.nan],
+            "ssw_N": [0.5, 0.6, 2.0, math.nan],
+            "resolved": [False, False, True, False],
+            "upper_limit": [True, True, False, False],
         }
     )
     fits = ssw_fits().assign(slope=[math.nan, 0.02], n_points=[0, 1])
@@ -347,13 +352,15 @@ def test_ssw_keys_and_rows():
         {
             "source": "simulation",
             "model": "elastic",
-            "N": [25, 26],
+            "N": [25, 26, 120, 121],
             "wave": "LSTW",
-            "ratio": [math.nan, 1.02],
-            "first_separated_contact": pd.array([pd.NA, 17], dtype="Int64"),
-            "distance_beads": [math.nan, 4.0],
-            "n_shots_separated": [0, 12],
-            "n_shots": [12, 12],
+            "ratio": [math.nan, 1.02, 1.018, 1.028],
+            "first_separated_contact": pd.array([pd.NA, 17, 64, 66], dtype="Int64"),
+            "distance_beads": [math.nan, 4.0, 4.0, 5.5],
+            "n_shots_separated": [0, 12, 12, 12],
+            "n_shots": [12, 12, 12, 12],
+            "ssw_over_Fm": [math.nan, math.nan, 0.03, 0.0085],
+            "ssw_over_Fm_err": [math.nan, math.nan, 3e-4, 1e-4],
         }
     )
     summary = build_summary(
@@ -381,8 +388,13 @@ def test_ssw_keys_and_rows():
     assert separation[26]["first_separated_contact"] == 17
     assert separation[26]["distance_beads"] == 4.0 and separation[26]["speed_ratio"] == 1.02
     assert summary["ssw_parity_ratio"] == [
-        {"source": "simulation", "model": "elastic", "ratio": None}
+        {"source": "simulation", "model": "elastic", "ratio": None, "ratio_err": None}
     ]
+    (far,) = summary["ssw_far_field"]
+    assert (far["even_N"], far["odd_N"]) == (120, 121)
+    assert far["ratio"] == pytest.approx(0.03 / 0.0085)
+    # Relative errors in quadrature: 1 % and 1.18 %.
+    assert far["ratio_err"] / far["ratio"] == pytest.approx(math.hypot(0.01, 1 / 85))
     json.loads(summary_json(summary))  # NaN-free
     text = summary_markdown(summary)
     assert "| SSW resolved at S2, simulation, elastic, N = 25 | — | no (0 of 2 shots)" in text
@@ -395,3 +407,4 @@ def test_ssw_keys_and_rows():
         "| SSW speed / Eq. 5 for its amplitude, simulation, elastic, N = 26 | — | 1.020 |" in text
     )
     assert "SSW slope ratio, simulation, elastic, N = 26 : N = 25 | > 1" in text
+    assert "SSW far field, even : odd, simulation, elastic, N = 120 : 121 | > 1" in text

@@ -23,6 +23,7 @@ import pandas as pd
 import pytest
 
 from chain.analysis.ssw_track import SPEED_COLUMNS, TRACK_COLUMNS
+from chain.report.printed import plus_minus
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "tests" / "configs" / "tiny.yaml"
@@ -261,10 +262,22 @@ def test_article_embeds_every_figure_and_prints_the_fits(tiny):
         for xobject in page.get("/Resources", {}).get("/XObject", {}).values()
     ]
     assert forms == ["/Form"] * len(list((out / "figures").glob("*.pdf")))
-    text = "".join(page.extract_text() for page in reader.pages)
+    text = re.sub(r"\s+", "", "".join(page.extract_text() for page in reader.pages))
     summary = json.loads((out / "summary.json").read_text())
     for row in summary["delay_fits"]:
-        assert f"{row['C_us_N16']:.2f}" in text, row
+        printed = plus_minus(row["C_us_N16"], row["C_stderr_us_N16"])
+        assert re.sub(r"\s+", "", printed).replace("10^", "10") in text, row
+    # Not a git checkout (a copy): the article says so rather than failing.
+    assert "notagitcheckout" in text
+
+
+def test_article_layout_is_clean(tiny):
+    """No word off a page, in the bottom margin or overprinted (tests/pdf_layout.py), in
+    the article the pipeline just built from real figures."""
+    from pdf_layout import layout_problems
+
+    _, out, _, _ = tiny
+    assert layout_problems(out / "article.pdf") == []
 
 
 def test_second_run_has_nothing_to_do(tiny):

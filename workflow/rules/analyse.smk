@@ -137,7 +137,8 @@ rule c_sensitivity:
 
 # The SSW as a wave (issue 13): each chain's collisions re-simulated with every contact
 # recorded (the simulate rule keeps two sensor readings only), the SSW tracked contact
-# by contact; the field of the shot the space-time figure shows is kept.
+# by contact; the field of the shot the space-time figure shows is kept. The long chains
+# (config long_chains) run here only: collisions in the middle, for the SSW far field.
 rule ssw_track:
     input:
         code("ssw_track"),
@@ -161,9 +162,10 @@ rule ssw_track:
         material=config["material"],
         radius_m=config["radius_m"],
         eta_s=lambda wildcards: MODELS[wildcards.model]["eta_s"],
-        sensors=lambda wildcards: CHAINS[int(wildcards.N)]["sensors"],
+        sensors=lambda wildcards: chain_sensors(int(wildcards.N)),
         speeds_m_s=SPEEDS,
         simulation=config["simulation"],
+        duration_s=lambda wildcards: simulated_duration(int(wildcards.N)),
         representative_force_N=config["figures"]["representative_force_N"],
         representative_index=config["figures"]["representative_index"],
     script:
@@ -174,7 +176,8 @@ rule ssw_speed:
     input:
         tracks=[
             f"{OUT}/simulation/{model}_N{n}_ssw_track.csv"
-            for _, model, n in SIMULATION_PARTS
+            for model in MODELS
+            for n in TRACKED_N
         ],
         lib=code("ssw_speed"),
     output:

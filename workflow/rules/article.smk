@@ -4,6 +4,8 @@
 
 import os
 
+from chain.pipeline.provenance import run_provenance
+
 ARTICLE_SOURCE = os.path.relpath(
     Path(workflow.basedir) / "workflow" / "report" / "article.typ", Path.cwd()
 )
@@ -35,5 +37,8 @@ rule article:
             "striker_radius_m": config["setup"]["striker_radius_m"],
             "tolerance": config["experiment"]["tolerance"],
         },
+        # Commit, commit date, config hash and versions: a changed commit or
+        # configuration rebuilds the article, which states them.
+        provenance=run_provenance(config, workflow.basedir),
     script:
         "../scripts/article.py"

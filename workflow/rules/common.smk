@@ -11,6 +11,7 @@ from chain.pipeline.config import (
     VIRTUAL_SERIES,
     check_config,
     experiment_parts,
+    long_chain_duration,
     virtual_experiment_settings,
 )
 from chain.pipeline.config import experiment_label as experiment_label_of
@@ -73,6 +74,23 @@ SPEEDS = [
 # Models without dissipation: their energy drift is the integrator's error.
 CONSERVATIVE = [name for name, m in MODELS.items() if m["eta_s"] == 0]
 TRACES_N = config["figures"]["traces_N"] or list(CHAINS)
+# Long chains (SSW far field): collisions only, every contact recorded, no sensors.
+LONG_CHAINS = list(config["long_chains"]["N"])
+# Chains whose SSW is tracked contact by contact (rule ssw_track).
+TRACKED_N = list(CHAINS) + LONG_CHAINS
+
+
+def simulated_duration(n):
+    """Simulated time of the chain of n beads, s (long chains: in proportion to N)."""
+    if n in CHAINS:
+        return config["simulation"]["duration_s"]
+    return long_chain_duration(config, n)
+
+
+def chain_sensors(n):
+    """Sensor beads of the chain of n beads (none for a long chain)."""
+    return CHAINS[n]["sensors"] if n in CHAINS else []
+
 
 # The code each job runs is an input of its rule: the script's local helpers and every
 # chain module it imports, read off the import statements (chain.pipeline.deps), so
@@ -258,7 +276,7 @@ def simulated_chain(wildcards):
         config["radius_m"],
         MODELS[wildcards.model]["eta_s"],
         sensor_beads=(
-            CHAINS[n]["sensors"] if config["simulation"]["readout"] == "sensor" else ()
+            chain_sensors(n) if config["simulation"]["readout"] == "sensor" else ()
         ),
     )
 
@@ -269,7 +287,7 @@ def simulate_needs(wildcards, threads):
         simulated_chain(wildcards),
         len(SPEEDS),
         max(SPEEDS),
-        sim["duration_s"],
+        simulated_duration(int(wildcards.N)),
         sim["record_interval_s"],
         sim["time_step_s"],
         threads,
@@ -284,7 +302,7 @@ def simulate_threads(wildcards):
         simulated_chain(wildcards),
         len(SPEEDS),
         max(SPEEDS),
-        sim["duration_s"],
+        simulated_duration(int(wildcards.N)),
         sim["time_step_s"],
     )
 

@@ -100,6 +100,8 @@ rule fig5_ssw_vs_force:
     input:
         ssw=f"{TABLES}/ssw.csv",
         fits=f"{TABLES}/ssw_fits.csv",
+        track=f"{TABLES}/ssw_track.csv",
+        speed=f"{TABLES}/ssw_speed.csv",
         lib=code("fig5_ssw_vs_force"),
     output:
         **figure_outputs("fig5_ssw_vs_force"),
@@ -111,6 +113,7 @@ rule fig5_ssw_vs_force:
         ENV
     params:
         experiment_label=experiment_label,
+        sensors={n: c["sensors"] for n, c in CHAINS.items()},
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -141,6 +144,9 @@ SPACETIME_MODEL = CONSERVATIVE[0] if CONSERVATIVE else config["figures"]["traces
 rule ssw_spacetime:
     input:
         fields=[f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in TRACES_N],
+        long_fields=[
+            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in LONG_CHAINS
+        ],
         track=f"{TABLES}/ssw_track.csv",
         lib=code("fig_ssw_spacetime"),
     output:
@@ -154,6 +160,7 @@ rule ssw_spacetime:
     params:
         model=SPACETIME_MODEL,
         chains=TRACES_N,
+        long_chains=LONG_CHAINS,
     script:
         "../scripts/fig_ssw_spacetime.py"
 

@@ -15,6 +15,7 @@ numbers = article_numbers(
     delays=pd.read_csv(snakemake.input.delays),
     ssw=pd.read_csv(snakemake.input.ssw),
     setup=snakemake.params.setup,
+    provenance=snakemake.params.provenance,
 )
 compile_article(snakemake.input.source, numbers, snakemake.input.figures, snakemake.output[0])
 log.info("claims: %s", [(c["claim"], c["agrees"]) for c in numbers["claims"]])

@@ -9,11 +9,17 @@ from chain.report.fig_ssw_spacetime import fig_ssw_spacetime
 from chain.report.style import save_figure
 
 log = start(snakemake)
-# One field file per chain, in the order of params.chains.
+# One field file per chain, in the order of params.chains (long_chains: of long_fields).
 fields = {
     int(n): pd.read_csv(path)
     for n, path in zip(snakemake.params.chains, snakemake.input.fields, strict=True)
 }
-fig = fig_ssw_spacetime(fields, pd.read_csv(snakemake.input.track), snakemake.params.model)
+long_fields = {
+    int(n): pd.read_csv(path)
+    for n, path in zip(snakemake.params.long_chains, snakemake.input.long_fields, strict=True)
+}
+fig = fig_ssw_spacetime(
+    fields, pd.read_csv(snakemake.input.track), snakemake.params.model, long_fields
+)
 save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
 log.info("done")

@@ -27,7 +27,7 @@ result = simulate(
     model,
     p.speeds_m_s,
     p.speeds_m_s,
-    duration=sim["duration_s"],
+    duration=p.duration_s,
     dt=dt,
     record_interval=sim["record_interval_s"],
     max_energy_drift=sim["max_energy_drift"],

@@ -247,3 +247,24 @@ def _points(x, y, sigma):
     if np.any(~np.isfinite(x)) or np.any(~np.isfinite(y)):
         raise ParameterError("x and y must be finite; drop flagged points before fitting")
     return x, y, weight
+
+
+def ratio_with_error(top: float, top_err: float, bottom: float, bottom_err: float) -> dict:
+    """top / bottom and its error, the relative errors added in quadrature.
+
+    Parameters
+    ----------
+    top, top_err, bottom, bottom_err : float
+        The two numbers and their errors (same units each).
+
+    Returns
+    -------
+    dict
+        ``ratio`` and ``ratio_err`` (NaN where ``bottom`` is 0 or NaN).
+    """
+    top, top_err, bottom, bottom_err = map(float, (top, top_err, bottom, bottom_err))
+    if not bottom or not math.isfinite(bottom):
+        return {"ratio": math.nan, "ratio_err": math.nan}
+    ratio = top / bottom
+    relative = math.hypot(top_err / top if top else math.nan, bottom_err / bottom)
+    return {"ratio": ratio, "ratio_err": abs(ratio) * relative}

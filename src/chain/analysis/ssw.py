@@ -1,9 +1,9 @@
 """Secondary solitary waves (SSW) at the sensors: the small waves born where the two
-pulses crossed, read behind each crossed pulse.
+pulses crossed, read behind each crossed pulse, with their errors.
 
 At the paper's sensors the SSW has barely, or not yet, separated from the crossed pulse
-(``chain.analysis.ssw_track`` follows it contact by contact). A value is therefore
-reported only where the SSW is **resolved at the sensor**:
+(``chain.analysis.ssw_track`` follows it contact by contact). Every measurable row gets
+a value with an error bar; whether it is a separate wave is a second, stricter question:
 
 1. **Template.** The reference pulse at the same distance from the launching end (the
    reference shot of the same amplitude at S2: for LSTW crossed at S2 that is the same
@@ -14,22 +14,28 @@ reported only where the SSW is **resolved at the sensor**:
    T - tau to its highest sample, which the trailing SSW does not reach), a and the
    time shift free. ``template_misfit_N`` is the largest misfit there (of the
    smoothed residual, as the SSW is read from it).
-2. **A distinct bump.** Within :data:`WINDOW_TAUS` tau behind the crossed peak, the
-   (smoothed) signal must have a local maximum of prominence at least
+2. **The value** (method ``residual``): the largest (signal - template), smoothed, from
+   the crossed pulse's **trailing minimum** (where a distinct bump follows it, rule 4)
+   or else from one tau behind the crossed peak, to :data:`WINDOW_TAUS` tau behind the
+   peak. The smoothing is quadratic Savitzky-Golay, tau/2 long (the SSW is about tau
+   wide, the noise is not). Method ``peak``: the distinct bump's smoothed height (only
+   where there is one).
+3. **Its error.** Systematic ``ssw_sys_N``: the template misfit on the rising edge (the
+   template is no better than that behind the peak either; for ``peak``: the crossed
+   pulse's tail under the bump, the smoothed signal at the trailing minimum).
+   Statistical ``ssw_stat_N``: :data:`NOISE_SIGMAS` standard deviations of the smoothed
+   noise (a 3-sigma bound, as the value is a maximum over ~10 independent smoothed
+   samples, not one reading). ``ssw_err_N``: both in quadrature. A value not above its
+   error is an **upper limit** (``upper_limit``; drawn at value + error).
+4. **Resolved** (``resolved``, the strict rule): a distinct bump -- a local maximum of
+   the smoothed signal within the window, of prominence at least
    :data:`MIN_PEAK_FRACTION` of the crossed pulse and :data:`MIN_PEAK_SNR` sigma of the
-   smoothed noise. The lowest point between the crossed peak and that maximum is the
-   crossed pulse's **trailing minimum**; nothing before it is ever read as SSW.
-3. **Its size.** ``residual``: the largest value of (signal - template), smoothed, from
-   the trailing minimum to the bump's far base. ``peak``: the bump's height above the
-   baseline. The smoothing is quadratic Savitzky-Golay, tau/2 long (the SSW is about
-   tau wide, the noise is not).
-4. **Above the floor.** The residual must exceed ``ssw_floor_N`` =
-   :data:`RESOLVE_FACTOR` x (template misfit + :data:`NOISE_SIGMAS` sigma of the
-   smoothed noise): residuals of the size of the misfit where no SSW can be are shape
-   mismatch, not SSW.
+   smoothed noise -- whose largest residual exceeds ``ssw_floor_N`` =
+   :data:`RESOLVE_FACTOR` x (template misfit + :data:`NOISE_SIGMAS` sigma).
 
-Otherwise both rows have ``ok`` False with the reason :data:`NOT_RESOLVED`.
-:func:`ssw_fit_table` fits SSW = slope x F_m through the origin on resolved rows (Fig. 5).
+``ok`` means measurable (``reason`` says why not). :func:`ssw_fit_table` fits
+SSW = slope x F_m through the origin on every measurable row, weighted by its error
+(Fig. 5), with a statistical and a systematic error of the slope.
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from chain.analysis.pulses import estimate_baseline
-from chain.analysis.regression import fit_proportional
+from chain.analysis.regression import fit_proportional, ratio_with_error
 from chain.analysis.rows import is_ok
 from chain.analysis.selection import apply_selection
 from chain.traces import iter_shots, sensor_beads
@@ -54,8 +60,8 @@ RESOLVE_FACTOR = 2.0
 #: The noise part of the floor, in standard deviations of the smoothed noise.
 NOISE_SIGMAS = 3.0
 
-#: Reason of the rows where no SSW clears the floor.
-NOT_RESOLVED = "not resolved at the sensor"
+#: Reason of the ``peak`` rows without a distinct bump to read.
+NO_BUMP = "no distinct bump behind the crossed pulse"
 
 #: Least prominence of a distinct SSW peak, as a fraction of the crossed pulse.
 MIN_PEAK_FRACTION = 0.005
@@ -89,10 +95,26 @@ SSW_COLUMNS = (
     "ssw_floor_N",
     "trailing_min_us",
     "ssw_candidate_N",
+    "ssw_sys_N",
+    "ssw_stat_N",
+    "ssw_err_N",
+    "resolved",
+    "upper_limit",
 )
 
 #: Columns of :func:`ssw_fit_table`.
-SSW_FIT_COLUMNS = ("source", "model", "N", "slope", "slope_stderr", "n_points", "method")
+SSW_FIT_COLUMNS = (
+    "source",
+    "model",
+    "N",
+    "slope",
+    "slope_stderr",
+    "slope_stat",
+    "slope_sys",
+    "n_points",
+    "n_resolved",
+    "method",
+)
 
 #: Crossed wave read at each sensor, and where its incident amplitude was measured.
 _CROSSED = {"S2": ("LSTW", "S1"), "S1": ("RSTW", "S2")}
@@ -143,8 +165,9 @@ def measure_ssw(
     baseline_N: float = 0.0,
     reference_baseline_N: float = 0.0,
     noise_N: float = 0.0,
+    reference_noise_N: float = 0.0,
 ) -> dict:
-    """SSW behind one crossed pulse, by both methods, where it is resolved.
+    """SSW behind one crossed pulse, by both methods, with what its errors need.
 
     Parameters
     ----------
@@ -158,18 +181,22 @@ def measure_ssw(
         Its fitted F_m (N) and T (s).
     baseline_N, reference_baseline_N : float
         Baseline offsets of the two signals, N.
-    noise_N : float
-        Noise standard deviation of the crossed signal, N.
+    noise_N, reference_noise_N : float
+        Noise standard deviations of the crossed and the reference signal, N (both
+        enter the residual; the reference's scaled by a).
 
     Returns
     -------
     dict
         ``{"residual": (ssw_N, time_s, reason), "peak": (...), "scale": a, "misfit": N,
-        "floor": N, "trailing_min_s": s, "candidate": N}``; ``reason`` is "" when the SSW
-        is resolved (values NaN otherwise); ``misfit`` is the largest smoothed
-        |signal - template| on the rising edge, ``floor`` the least resolved residual,
-        ``candidate`` the residual maximum read, resolved or not, ``trailing_min_s`` the time of
-        the crossed pulse's trailing minimum (NaN without a distinct bump).
+        "stat": N, "pedestal": N, "floor": N, "resolved": bool, "trailing_min_s": s,
+        "candidate": N}``; ``reason`` is "" when the value was read (NaN otherwise);
+        ``misfit`` is the largest smoothed |signal - template| on the rising edge,
+        ``stat`` :data:`NOISE_SIGMAS` sigma of the smoothed noise, ``pedestal`` the
+        smoothed signal at the trailing minimum, ``floor`` the least resolved residual,
+        ``candidate`` the residual maximum over the distinct bump, ``resolved`` whether
+        it clears the floor, ``trailing_min_s`` the time of the crossed pulse's trailing
+        minimum (NaN without a distinct bump).
     """
     # Imported here: scipy.interpolate and scipy.signal take most of a second to import,
     # and most jobs that import this module (for its tables' names) never measure.
@@ -181,6 +208,7 @@ def measure_ssw(
     nan = (math.nan, math.nan, "crossed pulse not sampled")
     result = {"residual": nan, "peak": nan, "scale": math.nan, "misfit": math.nan}
     result.update(floor=math.nan, trailing_min_s=math.nan, candidate=math.nan)
+    result.update(stat=math.nan, pedestal=math.nan, resolved=False)
     spline = CubicSpline(np.asarray(reference_time_s, dtype=float), ref_signal, extrapolate=False)
     aligned = _align_template(
         time,
@@ -199,22 +227,27 @@ def measure_ssw(
     residual = smooth(signal - template)
     # Measured on the smoothed residual, as the SSW is: the noise enters once, below.
     misfit = float(np.max(np.abs(residual[edge])))
-    floor = RESOLVE_FACTOR * (misfit + NOISE_SIGMAS * noise_gain * noise_N)
-    result.update(scale=scale, misfit=misfit, floor=floor)
-    window = np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)
+    stat = NOISE_SIGMAS * noise_gain * math.hypot(noise_N, scale * reference_noise_N)
+    result.update(scale=scale, misfit=misfit, floor=RESOLVE_FACTOR * (misfit + stat), stat=stat)
+    last = int(np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)[-1])
     prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
     smoothed = smooth(signal)
-    bump = _distinct_bump(smoothed, top, int(window[-1]), prominence)
-    unresolved = (math.nan, math.nan, NOT_RESOLVED)
-    result.update(residual=unresolved, peak=unresolved)
+    bump = _distinct_bump(smoothed, top, last, prominence)
+    # Behind the trailing minimum where there is one, else from one tau behind the peak.
+    start = bump[0] if bump else int(np.searchsorted(time, time[top] + crossed_tau_s))
+    if start > last:
+        result.update(residual=(math.nan, math.nan, "window past the record"), peak=nan)
+        return result
+    best = start + int(np.argmax(residual[start : last + 1]))
+    result["residual"] = (float(residual[best]), float(time[best]), "")
+    result["peak"] = (math.nan, math.nan, NO_BUMP)
     if bump is None:
         return result
     low, peak, far = bump
-    best = low + int(np.argmax(residual[low : far + 1]))
-    result.update(trailing_min_s=float(time[low]), candidate=float(residual[best]))
-    if residual[best] > floor:
-        result["residual"] = (float(residual[best]), float(time[best]), "")
-        result["peak"] = (float(smoothed[peak]), float(time[peak]), "")
+    candidate = low + int(np.argmax(residual[low : far + 1]))
+    result.update(trailing_min_s=float(time[low]), candidate=float(residual[candidate]))
+    result.update(resolved=bool(residual[candidate] > result["floor"]))
+    result.update(peak=(float(smoothed[peak]), float(time[peak]), ""), pedestal=smoothed[low])
     return result
 
 
@@ -304,10 +337,12 @@ def ssw_table(
         ``template_scale`` the force ratio a of the template to the reference,
         ``template_misfit_N`` the largest smoothed |signal - template| on the rising edge,
         ``ssw_floor_N`` the least resolved value, ``ssw_candidate_N`` the residual
-        maximum behind the trailing minimum whether or not it clears the floor (NaN
-        without a distinct bump), ``trailing_min_us`` the time of the
-        crossed pulse's trailing minimum. Unresolved rows: ``ok`` False, reason
-        :data:`NOT_RESOLVED`, ``ssw_N`` NaN.
+        maximum over the distinct bump whether or not it clears the floor (NaN
+        without one), ``trailing_min_us`` the time of the crossed pulse's trailing
+        minimum; ``ssw_sys_N``, ``ssw_stat_N``, ``ssw_err_N`` the systematic,
+        statistical and total error (N), ``resolved`` the strict rule, ``upper_limit``
+        value <= total error. Rows that cannot be measured: ``ok`` False, ``reason``
+        why, ``ssw_N`` NaN.
     """
     pulses = apply_selection(pulses[pulses["estimator"] == estimator], selection)
     beads = sensor_beads(traces)
@@ -393,10 +428,37 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
                 "ssw_floor_N": result["floor"],
                 "trailing_min_us": result["trailing_min_s"] * 1e6,
                 "ssw_candidate_N": result["candidate"],
+                "resolved": bool(result["resolved"]),
             }
         )
+        row.update(_errors(row["ssw_N"], result, method))
         rows.append(row)
     return rows
+
+
+def _errors(value: float, result: dict, method: str) -> dict:
+    """Systematic, statistical and total error (N) of one value, and the upper-limit flag."""
+    systematic = result["misfit"] if method == "residual" else result["pedestal"]
+    if not np.isfinite(value):
+        systematic = math.nan
+    total = math.hypot(systematic, result["stat"])
+    return {
+        "ssw_sys_N": systematic,
+        "ssw_stat_N": result["stat"] if np.isfinite(value) else math.nan,
+        "ssw_err_N": total,
+        "upper_limit": bool(np.isfinite(value) and is_upper_limit(value, total)),
+    }
+
+
+def is_upper_limit(value_N: float, error_N: float) -> bool:
+    """A value not above its (total) error is an upper limit, drawn at value + error.
+
+    Parameters
+    ----------
+    value_N, error_N : float
+        The SSW value and its total error, N.
+    """
+    return bool(value_N <= error_N)
 
 
 def _measure_at_sensor(shot: int, sensor: str, crossed, reference, context: dict) -> dict:
@@ -407,7 +469,7 @@ def _measure_at_sensor(shot: int, sensor: str, crossed, reference, context: dict
     ref_force = ref_forces[context["bead_of"]["S2"]]
     force = forces[context["bead_of"][sensor]]
     baseline, noise = estimate_baseline(time, force)
-    ref_baseline, _ = estimate_baseline(ref_time, ref_force)
+    ref_baseline, ref_noise = estimate_baseline(ref_time, ref_force)
     return measure_ssw(
         time,
         force,
@@ -421,11 +483,12 @@ def _measure_at_sensor(shot: int, sensor: str, crossed, reference, context: dict
         baseline_N=baseline,
         reference_baseline_N=ref_baseline,
         noise_N=noise,
+        reference_noise_N=ref_noise,
     )
 
 
 def _row(base, method, f_m, value, when, reason) -> dict:
-    ok = not reason
+    ok = not reason and bool(np.isfinite(value))
     return {
         **base,
         "F_m_N": f_m,
@@ -434,14 +497,19 @@ def _row(base, method, f_m, value, when, reason) -> dict:
         "method": method,
         "ok": ok,
         "reason": reason,
+        "ssw_sys_N": math.nan,
+        "ssw_stat_N": math.nan,
+        "ssw_err_N": math.nan,
+        "resolved": False,
+        "upper_limit": False,
     }
 
 
 def ssw_fit_table(ssw: pd.DataFrame, method: str = "residual") -> pd.DataFrame:
     """SSW = slope x F_m through the origin, per source, model and N (``ssw_fits.csv``).
 
-    Unweighted least squares of the ``ok`` rows of ``method``, standard error from the
-    residual scatter (:func:`chain.analysis.regression.fit_proportional`); fewer than 2 points
+    Every measurable (``ok``) row of ``method``, upper limits included at their values,
+    weighted by 1 / ``ssw_err_N``^2 (:func:`proportional_slope`). Fewer than 2 points
     give NaN and ``n_points``.
 
     Parameters
@@ -454,25 +522,63 @@ def ssw_fit_table(ssw: pd.DataFrame, method: str = "residual") -> pd.DataFrame:
     Returns
     -------
     DataFrame
-        ``source, model, N, method, slope, slope_stderr, n_points``; slope in N/N.
+        Columns :data:`SSW_FIT_COLUMNS`; slopes in N/N, ``n_resolved`` the fitted rows
+        that are resolved (the strict rule).
     """
     rows = []
     chosen = ssw[ssw["method"] == method]
     for (source, model, n_beads), group in chosen.groupby(["source", "model", "N"], sort=True):
         used = group[is_ok(group)]
-        fit = fit_proportional(used["F_m_N"].to_numpy(float), used["ssw_N"].to_numpy(float))
+        fit = proportional_slope(
+            used["F_m_N"].to_numpy(float),
+            used["ssw_N"].to_numpy(float),
+            used["ssw_err_N"].to_numpy(float),
+            used["ssw_sys_N"].to_numpy(float),
+        )
+        resolved = used["resolved"].astype(bool) if "resolved" in used else used["ok"]
         rows.append(
-            {
-                "source": source,
-                "model": model,
-                "N": int(n_beads),
-                "method": method,
-                "slope": fit.coefficient,
-                "slope_stderr": fit.stderr,
-                "n_points": fit.n_points,
-            }
+            {"source": source, "model": model, "N": int(n_beads), "method": method}
+            | fit
+            | {"n_resolved": int(resolved.sum())}
         )
     return pd.DataFrame(rows, columns=SSW_FIT_COLUMNS)
+
+
+def proportional_slope(force_N, value_N, error_N, systematic_N) -> dict:
+    """Slope of value = slope x force through the origin, with two errors.
+
+    Weighted least squares (weights 1 / error^2; unweighted where any error is not
+    positive). ``slope_stat``: the fit's standard error from the scatter of the points
+    (scaled by the reduced chi-square, so it measures how well they lie on a line
+    through the origin). ``slope_sys``: how far the slope moves when every value is
+    shifted by its systematic error (same weights). ``slope_stderr``: both in quadrature.
+
+    Parameters
+    ----------
+    force_N, value_N : array
+        Incident amplitudes and SSW values, N.
+    error_N : array
+        Total error of each value, N.
+    systematic_N : array
+        Systematic error of each value, N.
+
+    Returns
+    -------
+    dict
+        ``slope``, ``slope_stat``, ``slope_sys``, ``slope_stderr`` (N/N), ``n_points``.
+    """
+    error = np.asarray(error_N, dtype=float)
+    sigma = error if error.size and np.all(error > 0) else None
+    fit = fit_proportional(force_N, value_N, sigma)
+    shifted = fit_proportional(force_N, np.asarray(value_N) + np.asarray(systematic_N), sigma)
+    systematic = abs(shifted.coefficient - fit.coefficient)
+    return {
+        "slope": fit.coefficient,
+        "slope_stderr": math.hypot(fit.stderr, systematic),
+        "slope_stat": fit.stderr,
+        "slope_sys": systematic,
+        "n_points": fit.n_points,
+    }
 
 
 #: Columns of :func:`ssw_resolution_table` (summary key ``ssw_resolved``).
@@ -498,7 +604,7 @@ def ssw_resolution_table(ssw: pd.DataFrame, method: str = "residual") -> pd.Data
     rows = []
     chosen = ssw[ssw["method"] == method]
     for key, group in chosen.groupby(["source", "model", "N", "sensor"], sort=True):
-        n_resolved, n_total = int(is_ok(group).sum()), len(group)
+        n_resolved, n_total = int(group["resolved"].astype(bool).sum()), len(group)
         rows.append(
             dict(zip(RESOLUTION_COLUMNS[:4], key))
             | {"resolved": n_total > 0 and 2 * n_resolved >= n_total}
@@ -523,13 +629,22 @@ def ssw_parity_table(fits: pd.DataFrame, even: int = 26, odd: int = 25) -> pd.Da
     Returns
     -------
     DataFrame
-        ``source, model, ratio`` for every (source, model) with both chains.
+        ``source, model, ratio, ratio_err`` for every (source, model) with both chains;
+        ``ratio_err`` from the two slopes' ``slope_stderr`` in quadrature (relative),
+        NaN where a fit has none.
     """
     rows = []
     numeric = fits[fits["N"].astype(str).isin([str(even), str(odd)])]
     for (source, model), group in numeric.groupby(["source", "model"], sort=True):
-        slopes = dict(zip(group["N"].astype(int), group["slope"].astype(float)))
-        if even in slopes and odd in slopes:
-            ratio = slopes[even] / slopes[odd] if slopes[odd] else math.nan
-            rows.append({"source": source, "model": model, "ratio": ratio})
-    return pd.DataFrame(rows, columns=["source", "model", "ratio"])
+        by_n = {int(row.N): row for row in group.itertuples(index=False)}
+        if even in by_n and odd in by_n:
+            rows.append(
+                {"source": source, "model": model}
+                | ratio_with_error(
+                    by_n[even].slope,
+                    getattr(by_n[even], "slope_stderr", math.nan),
+                    by_n[odd].slope,
+                    getattr(by_n[odd], "slope_stderr", math.nan),
+                )
+            )
+    return pd.DataFrame(rows, columns=["source", "model", "ratio", "ratio_err"])

@@ -15,15 +15,22 @@ end it runs to. At every contact downstream of the collision point:
    (TRACK_FLOOR^(-1/6) - 1) beads' worth of the main pulse's transit time (d the
    distance from the collision point, Eq. 5's F^(1/6) speed law). The small waves that
    trail each pulse from its launch (born a whole half chain upstream) lag far more.
-4. **Moving in the same direction.** A maximum counts (``separated``) only if it
-   links to one at a neighbouring contact: arriving later at the downstream contact, by
-   no more than :data:`MAX_STEP_RATIO` main-pulse transit times.
+4. **Moving like a solitary wave of its size.** Maxima at neighbouring contacts link
+   when the downstream one arrives later by a transit time within a factor
+   :data:`SPEED_FACTOR` of Eq. 5's for its own amplitude: the main pulse's transit time
+   x (SSW / main pulse)^(-1/6) (the F^(1/6) speed law; no material needed).
+5. **Persisting.** A maximum is ``separated`` only as part of a run of at least
+   :data:`MIN_RUN` linked contacts, the fewest that show a speed. This is the one
+   definition of "separated", for every model and N: a bump seen at two contacts only
+   (e.g. the gap that opens and closes behind the crossed pulse with Kuwabara-Kono
+   dissipation, moving at half the speed a wave of its size would) is not an SSW, and
+   a smooth tail (Kuwabara-Kono's) has no maximum at all.
 
 A separated SSW is **detached** where the force between it and the crossed pulse (the
 trailing minimum) has fallen below the floor: until then it rides on the crossed
 pulse's tail and is pulled along (up to ~10 % faster than Eq. 5 in a 60-bead chain).
 The speed of the SSW is fitted on the detached contacts of its first run of separated
-contacts that it reaches before the main pulse reaches the last contact (afterwards the
+contacts that it reaches before the main pulse reaches the second-to-last contact (afterwards the
 end beads fly apart and the chain ahead of the SSW unloads; it slows down). Eq. 5 at the
 SSW's own mean amplitude over those contacts gives the speed a solitary wave of that
 size would have (:func:`ssw_speed_table` takes it as a function: this module knows no
@@ -39,6 +46,7 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
+from chain.analysis.regression import ratio_with_error
 from chain.errors import ParameterError
 
 #: Least SSW height and prominence, as a fraction of the incident amplitude F_m.
@@ -47,8 +55,13 @@ TRACK_FLOOR = 1e-3
 #: Width of the birth region around the collision point, beads (window of rule 3).
 BIRTH_BEADS = 2.0
 
-#: Largest SSW transit time between neighbouring contacts, in main-pulse transit times.
-MAX_STEP_RATIO = 1.5 * TRACK_FLOOR ** (-1.0 / 6.0)
+#: A link's transit time may differ from Eq. 5's for the SSW's own amplitude by this
+#: factor either way (a wave still riding on the crossed pulse's tail is pulled along,
+#: up to ~10 % faster; one slowing down where the chain ahead unloads, slower).
+SPEED_FACTOR = 2.0
+
+#: Fewest linked contacts of a separated SSW (two intervals: a speed).
+MIN_RUN = 3
 
 #: Fewest separated contacts for a speed fit (two intervals).
 MIN_SPEED_CONTACTS = 3
@@ -95,6 +108,8 @@ SPEED_COLUMNS = (
     "n_shots_separated",
     "ratio_min",
     "ratio_max",
+    "ssw_over_Fm",
+    "ssw_over_Fm_err",
 )
 
 
@@ -105,6 +120,20 @@ def collision_point(n_beads: int) -> float:
     sits at k + 1/2.
     """
     return 0.5 * (n_beads + 1)
+
+
+def sensor_distance(n_beads: int, sensors) -> float:
+    """Distance of the sensor beads from the collision point, beads (the farther one;
+    the paper's sensors sit symmetrically).
+
+    Parameters
+    ----------
+    n_beads : int
+        N.
+    sensors : sequence of int
+        Sensor beads, 1..N.
+    """
+    return float(max(abs(bead - collision_point(n_beads)) for bead in sensors))
 
 
 def _downstream(n_beads: int) -> np.ndarray:
@@ -162,7 +191,8 @@ def track_wave(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict:
     trough = np.array(
         [force[m:i, k - 1].min() if i >= 0 else math.nan for m, i, k in zip(main, found, contacts)]
     )
-    separated = _linked(ssw_time, step)
+    main_force = force[main, contacts - 1]
+    separated = _linked(ssw_time, ssw_force / main_force, step)
     return {
         "contact": contacts,
         "time_s": ssw_time,
@@ -171,7 +201,7 @@ def track_wave(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict:
         "detached": separated & (trough <= floor * f_m),
         "trailing_min_N": trough,
         "main_time_s": time[main],
-        "main_force_N": force[main, contacts - 1],
+        "main_force_N": main_force,
         "other_time_s": np.array(
             [time[np.argmax(np.where(before, force[:, k - 1], -np.inf))] for k in contacts]
         ),
@@ -226,16 +256,35 @@ def _prominence(x: np.ndarray, peak: int) -> float:
     return top - max(x[left : peak + 1].min(), x[peak:right].min())
 
 
-def _linked(ssw_time, step: float) -> np.ndarray:
-    """True where an SSW maximum links to one at a neighbouring contact: later
-    downstream, by at most MAX_STEP_RATIO main-pulse steps (same direction of travel)."""
+def _linked(ssw_time, relative_force, step: float) -> np.ndarray:
+    """True where an SSW maximum is part of a run of at least MIN_RUN linked contacts.
+
+    Neighbours link when the downstream maximum is later by Eq. 5's transit time for the
+    SSW's size, ``step`` x (SSW / main pulse)^(-1/6), within a factor SPEED_FACTOR.
+
+    Parameters
+    ----------
+    ssw_time : array
+        Time of the SSW maximum per contact, outward, s (NaN where none).
+    relative_force : array
+        SSW maximum over the crossed pulse's peak at the same contact.
+    step : float
+        The crossed pulse's transit time between neighbouring contacts, s.
+    """
     gaps = np.diff(ssw_time)
-    with np.errstate(invalid="ignore"):
-        link = (gaps > 0) & (gaps <= MAX_STEP_RATIO * step)
-    linked = np.zeros(ssw_time.size, dtype=bool)
-    linked[:-1] |= link
-    linked[1:] |= link
-    return linked
+    with np.errstate(invalid="ignore", divide="ignore"):
+        size = 0.5 * (relative_force[1:] + relative_force[:-1])
+        expected = step * size ** (-1.0 / 6.0)
+        link = (gaps > expected / SPEED_FACTOR) & (gaps < expected * SPEED_FACTOR)
+    separated = np.zeros(ssw_time.size, dtype=bool)
+    start = 0
+    # Runs of consecutive links: contacts start..end joined by end - start links.
+    for end in range(link.size + 1):
+        if end == link.size or not link[end]:
+            if end - start + 1 >= MIN_RUN:
+                separated[start : end + 1] = True
+            start = end + 1
+    return separated
 
 
 def track_collision(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> dict[str, dict]:
@@ -320,7 +369,7 @@ def _track_rows(found: dict, source, model, n_beads, shot, wave) -> pd.DataFrame
 
 
 def shot_speed(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> dict:
-    """SSW speed of one shot and wave from its ``ssw_track.csv`` rows.
+    """SSW speed and far-field size of one shot and wave from its ``ssw_track.csv`` rows.
 
     Parameters
     ----------
@@ -339,15 +388,38 @@ def shot_speed(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> di
         collision point, or None), ``distance_beads`` (its distance from it),
         ``first_detached_contact`` (or None), ``n_contacts`` (of the fit),
         ``speed_m_s``, ``eq5_speed_m_s``, ``force_N`` (mean SSW maximum over the fit),
-        ``ratio`` (NaN below :data:`MIN_SPEED_CONTACTS` contacts).
+        ``ratio`` (NaN below :data:`MIN_SPEED_CONTACTS` contacts), ``far_over_Fm`` (SSW /
+        F_m at the last contact of its first separated run before the main pulse
+        reaches the second-to-last contact: the farthest it is seen undisturbed; detached or not,
+        as with Kuwabara-Kono the tail between the two waves rarely empties) and
+        ``far_change`` (how much SSW / F_m changed over the last MIN_SPEED_CONTACTS
+        contacts: not yet settled by that much).
     """
+    result, run, undisturbed = _speed_run(track)
+    result.update(far_over_Fm=math.nan, far_change=math.nan)
+    if len(undisturbed) >= MIN_SPEED_CONTACTS:
+        size = (undisturbed["force_N"] / undisturbed["F_m_N"]).to_numpy(float)
+        result.update(far_over_Fm=size[-1], far_change=abs(size[-1] - size[-MIN_SPEED_CONTACTS]))
+    if len(run) < MIN_SPEED_CONTACTS:
+        return result
+    slope_s = np.polyfit(run["distance_beads"], run["time_us"] * 1e-6, 1)[0]
+    force = float(run["force_N"].mean())
+    result.update(speed_m_s=spacing_m / slope_s, eq5_speed_m_s=float(eq5_speed(force)))
+    result.update(force_N=force, ratio=result["speed_m_s"] / result["eq5_speed_m_s"])
+    return result
+
+
+def _speed_run(track: pd.DataFrame) -> tuple[dict, pd.DataFrame, pd.DataFrame]:
+    """Where the SSW separates and detaches; the contacts its speed is fitted on (the
+    detached ones of its first run of separated contacts, before the main pulse reaches
+    the second-to-last contact); and that run's contacts before then, detached or not."""
     rows = track.sort_values("distance_beads")
     separated = rows["separated"].to_numpy(bool)
     result = {"first_separated_contact": None, "distance_beads": math.nan, "n_contacts": 0}
     result["first_detached_contact"] = None
     result.update(speed_m_s=math.nan, eq5_speed_m_s=math.nan, force_N=math.nan, ratio=math.nan)
     if not separated.any():
-        return result
+        return result, rows.iloc[:0], rows.iloc[:0]
     first = int(np.argmax(separated))
     stop = first + int(np.argmin(np.append(separated[first:], False)))
     run = rows.iloc[first:stop]
@@ -356,16 +428,11 @@ def shot_speed(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> di
     detached = run[run["detached"].to_numpy(bool)]
     if not detached.empty:
         result["first_detached_contact"] = int(detached["contact"].iloc[0])
-    # The chain ahead unloads once the main pulse has reached the last contact.
-    run = detached[detached["time_us"] < rows["main_time_us"].iloc[-1]]
-    result["n_contacts"] = len(run)
-    if len(run) < MIN_SPEED_CONTACTS:
-        return result
-    slope_s = np.polyfit(run["distance_beads"], run["time_us"] * 1e-6, 1)[0]
-    force = float(run["force_N"].mean())
-    result.update(speed_m_s=spacing_m / slope_s, eq5_speed_m_s=float(eq5_speed(force)))
-    result.update(force_N=force, ratio=result["speed_m_s"] / result["eq5_speed_m_s"])
-    return result
+    # The chain ahead unloads once the main pulse has reached the end; the last
+    # contact's own peak comes late (the end bead flies off), so the one before it.
+    end = rows["main_time_us"].iloc[-2] if len(rows) > 1 else rows["main_time_us"].iloc[-1]
+    result["n_contacts"] = int((detached["time_us"] < end).sum())
+    return result, detached[detached["time_us"] < end], run[run["time_us"] < end]
 
 
 def ssw_speed_table(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) -> pd.DataFrame:
@@ -389,7 +456,9 @@ def ssw_speed_table(track: pd.DataFrame, eq5_speed: Callable, spacing_m: float) 
     Returns
     -------
     DataFrame
-        Columns :data:`SPEED_COLUMNS`; speeds in m/s, ``ratio`` = speed / Eq. 5.
+        Columns :data:`SPEED_COLUMNS`; speeds in m/s, ``ratio`` = speed / Eq. 5;
+        ``ssw_over_Fm`` and its error: the SSW far from the collision point
+        (:func:`shot_speed`'s ``far_over_Fm``, mean over the shots with a speed).
     """
     rows = []
     for key, group in track.groupby(["source", "model", "N", "wave"], sort=True):
@@ -421,7 +490,20 @@ def _speed_row(base: dict, shots: list[dict]) -> dict:
         "n_shots_separated": len(separated),
         "ratio_min": min(ratios, default=math.nan),
         "ratio_max": max(ratios, default=math.nan),
+        **_far_field([s for s in shots if np.isfinite(s["far_over_Fm"])]),
     }
+
+
+def _far_field(shots: list[dict]) -> dict:
+    """SSW / F_m far from the collision point over the shots that have it: the mean, and
+    its error, the shot-to-shot spread and the mean change over the last contacts
+    (how far from settled) in quadrature."""
+    far = np.array([s["far_over_Fm"] for s in shots], dtype=float)
+    if not far.size:
+        return {"ssw_over_Fm": math.nan, "ssw_over_Fm_err": math.nan}
+    spread = float(np.std(far, ddof=1)) if far.size > 1 else 0.0
+    change = float(np.mean([s["far_change"] for s in shots]))
+    return {"ssw_over_Fm": float(np.mean(far)), "ssw_over_Fm_err": math.hypot(spread, change)}
 
 
 def representative_shot(track: pd.DataFrame, force_N: float, index: int | None = None) -> int:
@@ -499,3 +581,55 @@ def separation_table(speed: pd.DataFrame) -> pd.DataFrame:
     """
     table = speed.rename(columns={"ratio": "speed_ratio"})
     return table[list(SEPARATION_COLUMNS)].reset_index(drop=True)
+
+
+#: Columns of :func:`far_field_parity` (summary key ``ssw_far_field``).
+FAR_FIELD_COLUMNS = (
+    "source",
+    "model",
+    "even_N",
+    "odd_N",
+    "even",
+    "even_err",
+    "odd",
+    "odd_err",
+    "ratio",
+    "ratio_err",
+)
+
+
+def far_field_parity(speed: pd.DataFrame) -> pd.DataFrame:
+    """The SSW far from the collision point, even chain over odd, per source and model.
+
+    The longest even and the longest odd chain with a far-field value (LSTW; RSTW is its
+    mirror) are compared: SSW / F_m of each with its error, and their ratio with its
+    error (relative errors in quadrature).
+
+    Parameters
+    ----------
+    speed : DataFrame
+        ``ssw_speed.csv`` rows (:func:`ssw_speed_table`).
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`FAR_FIELD_COLUMNS` (SSW / F_m dimensionless); no row for a model
+        without both an even and an odd chain.
+    """
+    rows = []
+    usable = speed[(speed["wave"] == "LSTW") & np.isfinite(speed["ssw_over_Fm"])]
+    for (source, model), group in usable.groupby(["source", "model"], sort=True):
+        even = group[group["N"] % 2 == 0].sort_values("N")
+        odd = group[group["N"] % 2 == 1].sort_values("N")
+        if even.empty or odd.empty:
+            continue
+        e, o = even.iloc[-1], odd.iloc[-1]
+        rows.append(
+            {"source": source, "model": model, "even_N": int(e["N"]), "odd_N": int(o["N"])}
+            | {"even": e["ssw_over_Fm"], "even_err": e["ssw_over_Fm_err"]}
+            | {"odd": o["ssw_over_Fm"], "odd_err": o["ssw_over_Fm_err"]}
+            | ratio_with_error(
+                e["ssw_over_Fm"], e["ssw_over_Fm_err"], o["ssw_over_Fm"], o["ssw_over_Fm_err"]
+            )
+        )
+    return pd.DataFrame(rows, columns=FAR_FIELD_COLUMNS)

@@ -31,7 +31,11 @@ from chain.analysis.selection import select_shots
 from chain.errors import ParameterError
 from chain.errors import key_label as key_name
 from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
-from chain.pipeline.config import VIRTUAL_FIELDS, ConfigError, virtual_experiment_settings
+from chain.pipeline.virtual_settings import (
+    VIRTUAL_FIELDS,
+    ConfigError,
+    virtual_experiment_settings,
+)
 
 #: Keys a variant may set besides those of ``experiment.virtual``.
 EXTRA_KEYS = ("striker_radius_m", "tolerance")

@@ -56,44 +56,19 @@ from chain.physics.theory import (
     pulse_passing_time,
 )
 
+# Re-exported: the config checks and the rules name them from here.
+from chain.pipeline.virtual_settings import (  # noqa: F401
+    VIRTUAL_FIELDS,
+    ConfigError,
+    virtual_experiment_settings,
+)
+
 #: The duration must be this many times the time the slowest pulse needs to pass the
 #: far sensor (see the module docstring).
 DURATION_MARGIN = 1.2
 
 #: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
 SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
-
-#: Config key of experiment.virtual -> field of chain.apparatus.virtual.VirtualExperiment.
-VIRTUAL_FIELDS = {
-    "eta_s": "eta",
-    "drag_rate_per_s": "drag_rate",
-    "sensor_stiffness_N_per_m": "sensor_stiffness",
-    "sensitivity_mV_per_N": "sensitivity_mV_per_N",
-    "impact_speeds_m_s": "impact_speeds_m_s",
-    "drop_heights_m": "drop_heights_m",
-    "collision_shots": "collision_shots",
-    "reference_shots": "reference_shots",
-    "speed_mismatch": "speed_mismatch",
-    "timing_jitter_s": "timing_jitter_s",
-    "noise_N": "noise_N",
-    "sampling_interval_s": "sampling_interval_s",
-    "adc_bits": "adc_bits",
-    "adc_range_V": "adc_range_V",
-    "duration_s": "duration_s",
-    "time_step_s": "time_step_s",
-    "readout": "readout",
-    "launch": "launch",
-    "reference_speed_mismatch": "reference_speed_mismatch",
-    "radius_dispersion": "radius_dispersion",
-    "gap_mean_m": "gap_mean_m",
-    "gap_spread_m": "gap_spread_m",
-    "right_speed_offset": "right_speed_offset",
-    "right_delay_s": "right_delay_s",
-}
-
-
-class ConfigError(ValueError):
-    """A configuration value is inconsistent; the message names the key."""
 
 
 def _fail(path, message: str):
@@ -119,40 +94,6 @@ def _check_duration(path, duration, config, v0, mass_ratio, what) -> None:
             f"from its launching end, at ~{passing['time_s'] * 1e3:.3g} ms; allowed: >= "
             f"{DURATION_MARGIN:g} x that = {needed:.3g} s (or faster launches)",
         )
-
-
-def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence[int]) -> dict:
-    """The :class:`chain.apparatus.virtual.VirtualExperiment` fields for one chain of a config.
-
-    Material and radius are the run's, the striker radius ``setup.striker_radius_m``,
-    the seed the top-level seed + N (so that the chains' shots differ), the rest
-    ``experiment.virtual`` renamed by :data:`VIRTUAL_FIELDS`.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in).
-    n_beads : int
-        N.
-    sensors : sequence of int
-        Sensor beads [S1, S2].
-
-    Returns
-    -------
-    dict
-        Plain values (lists for tuples), ready for ``VirtualExperiment.from_dict``.
-    """
-    virtual = config.get("experiment", {}).get("virtual", {})
-    settings = {VIRTUAL_FIELDS[key]: value for key, value in virtual.items()}
-    settings.update(
-        n_beads=int(n_beads),
-        sensor_beads=[int(b) for b in sensors],
-        material=config["material"],
-        radius=config["radius_m"],
-        striker_radius=config.get("setup", {}).get("striker_radius_m", 0.004),
-        seed=int(config.get("seed", 0)) + int(n_beads),
-    )
-    return settings
 
 
 def _check_sources(experiment: Mapping) -> None:
@@ -289,7 +230,32 @@ def _check_chains(config: Mapping) -> dict[int, int]:
                 ["chains", i, "sensors"],
                 f"got {[s1, s2]}; allowed: S1 left of S2 (S1 < S2; S1 is met first by the LSTW)",
             )
+    for i, n in enumerate(config.get("long_chains", {}).get("N", [])):
+        if n in seen_n:
+            _fail(
+                ["long_chains", "N", i],
+                f"N = {n} is also chains[{seen_n[n]}] (their files would clash); allowed: "
+                "an N not in chains",
+            )
     return seen_n
+
+
+def long_chain_duration(config: Mapping, n_beads: int) -> float:
+    """Simulated time of a long chain, s: ``long_chains.duration_s``, or by default
+    ``simulation.duration_s`` x N / the largest N of ``chains``.
+
+    Parameters
+    ----------
+    config : mapping
+        A schema-valid config (defaults filled in).
+    n_beads : int
+        N of the long chain.
+    """
+    duration = config.get("long_chains", {}).get("duration_s")
+    if duration is not None:
+        return float(duration)
+    longest = max(entry["N"] for entry in config["chains"])
+    return float(config["simulation"]["duration_s"]) * n_beads / longest
 
 
 def _check_models_and_launch(config: Mapping) -> list[str]:
@@ -395,7 +361,7 @@ def check_config(config: Mapping) -> None:
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
-    # Imported here: chain.pipeline.ablation imports this module.
+    # Imported here: the ablation module pulls in the analysis (pandas, the delay fits).
     from chain.pipeline.ablation import check_ablation
 
     check_ablation(config)

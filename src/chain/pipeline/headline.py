@@ -33,7 +33,7 @@ CONTRACT_TABLES = {
     "delays.csv": ("source", "model", "N", "F_m_N", "delay_us"),
     "delay_fits.csv": DELAY_FIT_COLUMNS[: DELAY_FIT_COLUMNS.index("n_points") + 1],
     "ssw.csv": ("source", "model", "N", "F_m_N", "ssw_N"),
-    "ssw_fits.csv": SSW_FIT_COLUMNS[: SSW_FIT_COLUMNS.index("n_points") + 1],
+    "ssw_fits.csv": SSW_FIT_COLUMNS[: SSW_FIT_COLUMNS.index("n_resolved") + 1],
     "ssw_track.csv": TRACK_COLUMNS[: TRACK_COLUMNS.index("separated") + 1],
     "ssw_speed.csv": SPEED_COLUMNS[: SPEED_COLUMNS.index("first_separated_contact") + 1],
 }
@@ -47,6 +47,7 @@ SUMMARY_KEYS = (
     "ssw_resolved",
     "ssw_separation",
     "ssw_parity_ratio",
+    "ssw_far_field",
 )
 
 #: Default tolerances, by kind of number and source. Simulations are deterministic

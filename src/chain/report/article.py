@@ -24,6 +24,8 @@ import pandas as pd
 
 from chain.atomic import atomic_output
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
+from chain.report.article_figures import CAPTIONS, figure_text
+from chain.report.article_tables import ablation_tables, c_spread_tables
 from chain.report.claims import (
     NOT_COMPUTED,
     TOLERANCES,
@@ -36,26 +38,6 @@ from chain.report.claims import (
 )
 from chain.report.paper import PAPER_ENERGY_DRIFT
 from chain.report.printed import fixed, percent, plus_minus, scientific, table_of
-
-#: Captions of the run's figures, by contract name (the article's own words).
-CAPTIONS = {
-    "fig1_setup": "The chain as configured for this run: beads, strikers, the two sensor "
-    "beads S1 and S2, and the left- and right-travelling waves (LSTW, RSTW).",
-    "fig2_experiment_traces": "Force at the two sensors in the experiment series of this "
-    "run, one column per chain: the left-launched wave solid, the right-launched dashed, "
-    "a reference wave that crossed nothing dotted.",
-    "fig3_simulation_traces": "The same from the simulation of Eq. 1, force felt by the "
-    "sensor beads (sensors not modelled), with the SSW marked where it is found.",
-    "fig4_delay_vs_force": "|Δ| against the incident amplitude F_m at the first sensor, "
-    "log-log: simulations, experiment series, the fits C F_m^(−1/6), the two ballistic "
-    "estimates, and the paper's C_exp quoted.",
-    "fig5_ssw_vs_force": "Amplitude of the secondary solitary wave against the incident "
-    "amplitude, per series and chain.",
-    "ssw_spacetime": "Contact force over contact index and time for one collision in an "
-    "odd and an even chain (log colour scale), with the tracked waves; beside it, the SSW "
-    "amplitude against distance from the collision point.",
-    "fig_parity_ssw_vs_N": "SSW slope against the number of beads, odd and even chains.",
-}
 
 
 def fit_rows(summary: Mapping) -> list[dict]:
@@ -87,25 +69,36 @@ def fit_rows(summary: Mapping) -> list[dict]:
 
 
 def ssw_slope_rows(summary: Mapping) -> list[dict]:
-    """Every row of ``ssw_fits``, printed: slope ± stderr (4 decimals), points."""
+    """Every row of ``ssw_fits``, printed: slope ± statistical ± systematic error (4
+    decimals; ± total where a table has no split), points (resolved)."""
     return [
         {
             "series": series_label(summary, r["source"], r["model"]),
             "N": str(r["N"]),
-            "slope": plus_minus(r.get("slope"), r.get("slope_stderr"), 4),
-            "points": str(r.get("n_points", "")),
+            "slope": _slope_text(r),
+            "points": str(r.get("n_points", ""))
+            + ("" if r.get("n_resolved") is None else f" ({r['n_resolved']} resolved)"),
         }
         for r in sorted(summary["ssw_fits"], key=lambda r: (r["source"], r["model"], str(r["N"])))
     ]
+
+
+def _slope_text(row: Mapping) -> str:
+    """'0.0343 ± < 0.0001 ± 0.0207' (slope ± stat ± sys), or slope ± stderr."""
+    if row.get("slope_sys") is None:
+        return plus_minus(row.get("slope"), row.get("slope_stderr"), 4)
+    return (
+        f"{plus_minus(row.get('slope'), row.get('slope_stat'), 4)} ± {fixed(row['slope_sys'], 4)}"
+    )
 
 
 def findings(summary: Mapping) -> dict:
     """The SSW, ablation and C-spread findings of the run, printed, or None each.
 
     Reads the summary keys ``ssw_resolved``, ``ssw_separation``, ``ssw_parity_ratio``,
-    ``ablation`` ({verdict, rows}), ``ssw_mechanisms`` ({verdict, rows, lammps_check})
-    and ``c_spread`` ({headline_choice, min_us_N16, max_us_N16, rows}); an absent or
-    empty key gives None.
+    ``ssw_far_field``, ``ablation`` ({verdict, rows}), ``ssw_mechanisms`` ({verdict,
+    rows, lammps_check}) and ``c_spread`` ({headline_choice, min_us_N16, max_us_N16,
+    rows}); an absent or empty key gives None.
     """
     resolved = summary.get("ssw_resolved") or None
     ablation = summary.get("ablation") or None
@@ -121,9 +114,13 @@ def findings(summary: Mapping) -> dict:
         },
         "ssw_separation": table_of(summary.get("ssw_separation")),
         "ssw_parity_ratio": table_of(summary.get("ssw_parity_ratio")),
+        "ssw_far_field": table_of(summary.get("ssw_far_field")),
         "ablation": None
         if ablation is None
-        else {"verdict": str(ablation.get("verdict", "")), "table": table_of(ablation.get("rows"))},
+        else {
+            "verdict": str(ablation.get("verdict", "")),
+            "tables": ablation_tables(ablation.get("rows")),
+        },
         "mechanisms": None
         if study is None
         else {
@@ -137,7 +134,7 @@ def findings(summary: Mapping) -> dict:
             "headline_choice": str(spread.get("headline_choice", "")),
             "min": fixed(spread.get("min_us_N16"), 2),
             "max": fixed(spread.get("max_us_N16"), 2),
-            "table": table_of(spread.get("rows")),
+            "tables": c_spread_tables(spread.get("rows")),
         },
     }
 
@@ -330,6 +327,7 @@ def article_numbers(
     delays: pd.DataFrame | None = None,
     ssw: pd.DataFrame | None = None,
     setup: Mapping | None = None,
+    provenance: Mapping | None = None,
 ) -> dict:
     """Everything the article prints, as strings: the JSON that article.typ reads.
 
@@ -344,6 +342,9 @@ def article_numbers(
         s), ``launch`` (count, v0_min_m_s, v0_max_m_s in m/s), ``source`` (experiment
         source), ``virtual`` (the virtual experiment's keys, SI), ``striker_radius_m``
         (m) and ``tolerance`` (acceptance, fraction).
+    provenance : mapping, optional
+        :func:`chain.pipeline.provenance.run_provenance` of the run (commit, date,
+        dirty, config_hash, versions); None prints "not recorded".
 
     Returns
     -------
@@ -351,7 +352,9 @@ def article_numbers(
         ``text`` (constants and labels), ``setup``, ``series`` (per source and model:
         pooled C, exponent, per-N C, estimator spread, attenuation), ``claims``,
         ``fits`` and ``ssw_slopes`` (every row, printed), ``findings`` (SSW, ablation,
-        C spread; None where not computed) and ``not_computed`` (the phrase for those).
+        C spread; None where not computed), ``figure_text`` (section, caption and
+        paragraph per known figure, :mod:`chain.report.article_figures`),
+        ``provenance`` and ``not_computed`` (the phrase for those).
     """
     return {
         "text": _constants_text(summary),
@@ -362,23 +365,45 @@ def article_numbers(
         "fits": fit_rows(summary),
         "ssw_slopes": ssw_slope_rows(summary),
         "findings": findings(summary),
+        "figure_text": {name: figure_text(name, summary) for name in CAPTIONS},
+        "provenance": provenance_text(provenance),
         "not_computed": NOT_COMPUTED,
     }
 
 
-def figure_entries(paths: Iterable[str | os.PathLike], root: Path) -> list[dict]:
+def provenance_text(provenance: Mapping | None) -> dict:
+    """The provenance as printed: ``source`` ('commit 0123456789ab, committed 2026-01-02',
+    with 'with uncommitted changes' when the tree was dirty, or why there is no commit),
+    ``config_hash`` and ``versions`` ('numpy 2.4.6, ...')."""
+    if not provenance:
+        return {"source": "an unrecorded checkout", "config_hash": "not recorded",
+                "versions": "not recorded"}  # fmt: skip
+    if provenance.get("date") is None:
+        source = f"a copy of the workflow that is {provenance.get('commit')} (no commit date)"
+    else:
+        dirty = " with uncommitted changes" if provenance.get("dirty") else ""
+        source = f"commit {provenance['commit']}{dirty}, committed {provenance['date']}"
+    versions = provenance.get("versions") or {}
+    return {
+        "source": source,
+        "config_hash": str(provenance.get("config_hash")),
+        "versions": ", ".join(f"{k} {v}" for k, v in versions.items()) or "not recorded",
+    }
+
+
+def figure_entries(
+    paths: Iterable[str | os.PathLike], root: Path, texts: Mapping | None = None
+) -> list[dict]:
     """The run's figures for the article: ``name`` (file stem), ``path`` (from the typst
-    root, with a leading ``/``) and ``caption``."""
+    root, with a leading ``/``), ``section``, ``caption`` and ``paragraph`` (from
+    ``texts``, the ``figure_text`` of :func:`article_numbers`; a figure not in it gets
+    the generic text of :func:`chain.report.article_figures.figure_text`)."""
+    texts = texts or {}
     out = []
     for path in paths:
         path = Path(path).resolve()
-        out.append(
-            {
-                "name": path.stem,
-                "path": "/" + path.relative_to(root).as_posix(),
-                "caption": CAPTIONS.get(path.stem, f"Figure {path.stem} of this run."),
-            }
-        )
+        text = texts.get(path.stem) or figure_text(path.stem, {})
+        out.append({"name": path.stem, "path": "/" + path.relative_to(root).as_posix(), **text})
     return out
 
 
@@ -411,7 +436,7 @@ def compile_article(
     source = Path(source).resolve()
     figures = [Path(path).resolve() for path in figures]
     root = Path(os.path.commonpath([source.parent, *figures]))
-    document = dict(numbers, figures=figure_entries(figures, root))
+    document = dict(numbers, figures=figure_entries(figures, root, numbers.get("figure_text")))
     pdf = typst.compile(
         str(source),
         root=str(root),

@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from chain.analysis.rows import usable_rows
 from chain.report import picks
 from chain.report.paper import PAPER
+from chain.report.printed import plus_minus
 from chain.report.style import (
     STYLE,
     add_legend,
@@ -116,7 +117,7 @@ def _plot_experiment(ax, experiment, all_n, per_chain, experiment_label) -> tupl
         label += f", N = {int(n)}"
         if (model, int(n)) in per_chain:
             c, err = per_chain[(model, int(n))]
-            label += f" (own fit C = {c:.1f} ± {err:.1f})"
+            label += f" (own fit C = {plus_minus(c, err, 1, style='mathtext')})"
         ax.plot(
             group["F_m_N"],
             group["abs_delay_us"],
@@ -148,7 +149,8 @@ def _plot_fits(ax, grid, pooled, colors, experiment_label) -> None:
             color=color,
             ls="--",
             lw=1.0,
-            label=f"{who}: C = {fit.C_us_N16:.1f} ± {fit.C_stderr_us_N16:.1f} µs N$^{{1/6}}$",
+            label=f"{who}: C = {plus_minus(fit.C_us_N16, fit.C_stderr_us_N16, 1, style='mathtext')}"
+            " µs N$^{1/6}$",
         )
 
 
@@ -177,8 +179,9 @@ def _reference_lines(constants, paper) -> list[tuple]:
             paper["C_exp_us_N16"],
             "#6a3d9a",
             (0, (1, 1.5)),
-            f"paper's experimental fit: C$_{{exp}}$ = {paper['C_exp_us_N16']:.1f} ± "
-            f"{paper['C_exp_err_us_N16']:.1f} µs N$^{{1/6}}$",
+            "paper's experimental fit: C$_{exp}$ = "
+            + plus_minus(paper["C_exp_us_N16"], paper["C_exp_err_us_N16"], 1, style="mathtext")
+            + " µs N$^{1/6}$",
         )
     )
     return references

@@ -1,10 +1,13 @@
 """Figure ssw_spacetime: the secondary solitary wave (SSW) seen along the chain.
 
-Left, one panel per chain: the contact force of one collision over time (x) and contact
-index (y), divided by the incident amplitude F_m, on a logarithmic colour scale from the
-tracking floor (0.1 % of F_m, white below) so that a 1 % wave shows. Over it, the two
+One panel per chain (the paper's chains on top, the long chains of config
+``long_chains`` below, where the SSW has room to run as its own line): the contact force
+of one collision at every recorded sample (the recording's own resolution, 1 us x 1
+contact in the paper run) over time (x) and contact index (y), divided by the incident
+amplitude F_m, on a logarithmic colour scale from the tracking floor (0.1 % of F_m, white
+below) so that a 1 % wave shows. Over it, the two
 main waves (incident dashed, crossed solid: peak times at each contact) and the tracked
-SSW (crosses, where it is separated). Right: the SSW amplitude over F_m against the
+SSW (crosses, where it is separated). Top right: the SSW amplitude over F_m against the
 distance from the collision point, every shot of every model and chain; a series that
 is never separated says so in the legend. Everything drawn comes from
 ``ssw_track.csv`` and the field file of the ``ssw_track`` rule; nothing is computed here.
@@ -71,9 +74,11 @@ def draw_waves(ax, track: pd.DataFrame) -> None:
             separated["contact"],
             ls="none",
             marker="+",
-            ms=5,
-            mew=1.0,
+            ms=4,
+            mew=0.8,
             color=TRACK_COLOR,
+            # About 8 markers per track, so that the wave under them stays visible.
+            markevery=max(1, len(separated) // 8),
         )
 
 
@@ -87,10 +92,11 @@ def draw_ssw_vs_distance(ax, series: list[dict]) -> None:
             item["ratio"],
             ls="none",
             marker=item["marker"],
-            ms=4,
+            ms=2.5,
+            alpha=0.6,
             color=item["color"],
             mfc=item["color"] if item["filled"] else "none",
-            mew=0.9,
+            mew=0.6,
             label=item["label"],
         )
     ax.set_xlabel("distance from the collision point (beads)")
@@ -123,39 +129,66 @@ def ssw_series(track: pd.DataFrame) -> list[dict]:
     return series
 
 
-def fig_ssw_spacetime(fields: dict[int, pd.DataFrame], track: pd.DataFrame, model: str) -> Figure:
-    """The space-time figure: field of one collision per chain of ``model``, and SSW
-    amplitude against distance for every model and chain.
+def fig_ssw_spacetime(
+    fields: dict[int, pd.DataFrame],
+    track: pd.DataFrame,
+    model: str,
+    long_fields: dict[int, pd.DataFrame] | None = None,
+) -> Figure:
+    """The space-time figure: field of one collision per chain of ``model`` (the paper's
+    chains on top, the long chains below), and SSW amplitude against distance for every
+    model and chain.
 
     Parameters
     ----------
     fields : dict
-        N -> field table of the shown collision (``<model>_N<N>_field.csv``).
+        N -> field table of the shown collision (``<model>_N<N>_field.csv``), the
+        paper's chains.
     track : DataFrame
         ``ssw_track.csv``.
     model : str
         Model of the fields.
+    long_fields : dict, optional
+        The same for the long chains (config ``long_chains``).
     """
-    fig = new_figure(3.0 * len(fields) + 3.2, 3.4)
+    long_fields = long_fields or {}
+    columns = max(len(fields), len(long_fields), 1)
+    rows = 2 if long_fields else 1
+    fig = new_figure(3.4 * columns + 3.4, 3.3 * rows + 0.6)
     with mpl.rc_context(STYLE):
-        axes = fig.subplots(1, len(fields) + 1, width_ratios=[1.0] * len(fields) + [1.1])
+        grid = fig.add_gridspec(rows, columns + 1, width_ratios=[1.0] * columns + [1.0])
         mesh = None
-        for ax, (n, field) in zip(axes, sorted(fields.items())):
-            shot = int(field["shot"].iloc[0])
-            rows = track[(track["model"] == model) & (track["N"] == n) & (track["shot"] == shot)]
-            f_m = float(rows["F_m_N"].iloc[0])
-            mesh = draw_field(ax, *field_image(field, f_m))
-            draw_waves(ax, rows)
-            ax.set_title(f"{model}, N = {n}, F$_m$ = {f_m:.0f} N", loc="left")
-        fig.colorbar(mesh, ax=list(axes[:-1]), label="contact force / F$_m$", shrink=0.9)
-        draw_ssw_vs_distance(axes[-1], ssw_series(track))
-        axes[-1].set_title("SSW where separated (all shots)", loc="left")
-        handles = [
-            mpl.lines.Line2D([], [], color=WAVE_COLORS["LSTW"], label="LSTW"),
-            mpl.lines.Line2D([], [], color=WAVE_COLORS["RSTW"], label="RSTW"),
-            mpl.lines.Line2D([], [], color="0.4", ls="--", label="incident (before crossing)"),
-            mpl.lines.Line2D([], [], color="0.4", ls="-", label="crossed (after)"),
-            mpl.lines.Line2D([], [], color=TRACK_COLOR, ls="none", marker="+", label="SSW tracked"),
-        ]
-        fig.legend(handles=handles, loc="outside lower left", ncol=5, fontsize=6, frameon=False)
+        for row, chains in enumerate((fields, long_fields)[:rows]):
+            for column, (n, field) in enumerate(sorted(chains.items())):
+                ax = fig.add_subplot(grid[row, column])
+                mesh = _field_panel(ax, n, field, track, model)
+        side = fig.add_subplot(grid[0, columns])
+        draw_ssw_vs_distance(side, ssw_series(track))
+        side.set_title("SSW where separated (all shots)", loc="left")
+        if mesh is not None:
+            fig.colorbar(mesh, ax=fig.axes[:-1], label="contact force / F$_m$", shrink=0.8)
+        fig.legend(handles=_wave_handles(), loc="outside lower left", ncol=5, fontsize=6,
+                   frameon=False)  # fmt: skip
     return fig
+
+
+def _field_panel(ax, n: int, field: pd.DataFrame, track: pd.DataFrame, model: str):
+    """One chain's field with its waves and tracked SSW; returns the mesh."""
+    shot = int(field["shot"].iloc[0])
+    rows = track[(track["model"] == model) & (track["N"] == n) & (track["shot"] == shot)]
+    f_m = float(rows["F_m_N"].iloc[0])
+    mesh = draw_field(ax, *field_image(field, f_m))
+    draw_waves(ax, rows)
+    ax.set_title(f"{model}, N = {n}, F$_m$ = {f_m:.0f} N", loc="left")
+    return mesh
+
+
+def _wave_handles() -> list:
+    line = mpl.lines.Line2D
+    return [
+        line([], [], color=WAVE_COLORS["LSTW"], label="LSTW"),
+        line([], [], color=WAVE_COLORS["RSTW"], label="RSTW"),
+        line([], [], color="0.4", ls="--", label="incident (before crossing)"),
+        line([], [], color="0.4", ls="-", label="crossed (after)"),
+        line([], [], color=TRACK_COLOR, ls="none", marker="+", label="SSW tracked (separated)"),
+    ]

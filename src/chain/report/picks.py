@@ -196,7 +196,8 @@ def first_shot(shots, kind: str, kept=None):
 
 
 def ssw_marker(ssw, meta, sensor: str) -> tuple[float, float] | None:
-    """(time µs, amplitude N) of the usable SSW of one shot at ``sensor``, or None."""
+    """(time µs, amplitude N) of the SSW of one shot at ``sensor`` where it is resolved
+    as a separate wave (``resolved``, else ``ok`` in older tables), or None."""
     if ssw is None or not len(ssw):
         return None
     ssw = main_method(ssw)
@@ -208,6 +209,8 @@ def ssw_marker(ssw, meta, sensor: str) -> tuple[float, float] | None:
         & (ssw["sensor"] == sensor)
         & is_ok(ssw)
     ]
+    if "resolved" in rows.columns:
+        rows = rows[rows["resolved"].astype(bool)]
     if len(rows) and np.isfinite(rows["ssw_time_us"].iloc[0]):
         return (float(rows["ssw_time_us"].iloc[0]), float(rows["ssw_N"].iloc[0]))
     return None

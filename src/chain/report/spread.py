@@ -14,6 +14,7 @@ from collections.abc import Mapping
 import pandas as pd
 
 from chain.labels import VIRTUAL_LABEL
+from chain.report.printed import fixed, plus_minus
 
 #: Variants the verdict names when present: the reference shots' mismatch alone off,
 #: and every imperfection off.
@@ -60,20 +61,22 @@ def ablation_summary(ablation: pd.DataFrame, delay_fits: pd.DataFrame, estimator
         & (delay_fits["N"].astype(str) == "pooled")
         & (delay_fits["estimator"] == estimator)
     ]
-    simulated = ", ".join(f"{m} {p:.3f}" for m, p in zip(sims["model"], sims["exponent"]))
+    simulated = ", ".join(f"{m} {fixed(p, 3)}" for m, p in zip(sims["model"], sims["exponent"]))
     others = pooled.drop(index=[_CAUSE, _CLEAN], errors="ignore")
     verdict = (
-        f"The {VIRTUAL_LABEL}'s steep free exponent ({r['exponent']:.3f} ± "
-        f"{r['exponent_stderr']:.3f}, chains pooled) comes from the random striker-speed "
-        "mismatch of its reference shots, whose time of flight every collision of the same "
-        f"amplitude shares: with that mismatch alone off it is {cause['exponent']:.3f} ± "
-        f"{cause['exponent_stderr']:.3f}, with every imperfection off {clean['exponent']:.3f} "
-        f"± {clean['exponent_stderr']:.3f} (simulations: {simulated})"
+        f"The {VIRTUAL_LABEL}'s steep free exponent "
+        f"({plus_minus(r['exponent'], r['exponent_stderr'])}, chains pooled) comes from the "
+        "random striker-speed mismatch of its reference shots, whose time of flight every "
+        "collision of the same "
+        "amplitude shares: with that mismatch alone off it is "
+        f"{plus_minus(cause['exponent'], cause['exponent_stderr'])}, with every imperfection "
+        f"off {plus_minus(clean['exponent'], clean['exponent_stderr'])} "
+        f"(simulations: {simulated})"
     )
     if not others.empty:
         verdict += (
-            f"; the other variants give {others['exponent'].min():.3f} .. "
-            f"{others['exponent'].max():.3f}"
+            f"; the other variants give {fixed(others['exponent'].min(), 3)} to "
+            f"{fixed(others['exponent'].max(), 3)}"
         )
     verdict += "; a property of the protocol's statistics, not a model artefact."
     return {"verdict": verdict, "rows": _records(ablation)}
@@ -90,8 +93,8 @@ def c_spread_summary(table: pd.DataFrame) -> dict:
     sim = table[table["headline"].astype(bool)]
     choice = (
         f"simulation, estimator {head['estimator']}, eta = {head['eta_us']:.3g} us, sensors "
-        f"{head['sensors']}, all amplitudes, chains pooled: C = {head['C']:.2f} ± "
-        f"{head['C_stderr']:.2f} us N^1/6"
+        f"{head['sensors']}, all amplitudes, chains pooled: "
+        f"C = {plus_minus(head['C'], head['C_stderr'])} us N^1/6"
     )
     low, high = pooled.loc[pooled["C"].idxmin()], pooled.loc[pooled["C"].idxmax()]
     return {

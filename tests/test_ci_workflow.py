@@ -1,0 +1,59 @@
+"""The GitHub Actions workflow (.github/workflows/ci.yml): valid against the workflow
+schema bundled with check-jsonschema (offline), so a broken file fails here before it
+fails on GitHub; its commands are the README's, so what CI runs is what a user types."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+WORKFLOWS = sorted((ROOT / ".github" / "workflows").glob("*.yml"))
+#: Commands of the project a step may run; they must appear in the README verbatim.
+PROJECT_COMMANDS = ("pip ", "python ", "snakemake ", "hertzchain ")
+
+
+def validate(path: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "check_jsonschema", "--builtin-schema",
+         "vendor.github-workflows", str(path)],
+        capture_output=True, text=True, check=False, stdin=subprocess.DEVNULL,
+    )  # fmt: skip
+
+
+def test_workflows_validate_against_the_schema():
+    assert WORKFLOWS, "no workflow under .github/workflows"
+    for path in WORKFLOWS:
+        result = validate(path)
+        assert result.returncode == 0 and "ok" in result.stdout, result.stdout + result.stderr
+
+
+def test_a_broken_workflow_fails_validation(tmp_path):
+    """The check can fail: a job with `step:` instead of `steps:`."""
+    broken = tmp_path / "broken.yml"
+    broken.write_text("on: push\njobs:\n  a:\n    runs-on: ubuntu-latest\n    step: []\n")
+    assert validate(broken).returncode != 0
+
+
+def _steps(workflow: dict):
+    for job in workflow["jobs"].values():
+        yield from job["steps"]
+
+
+def test_steps_are_the_readme_commands_and_keep_the_run():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    workflow = yaml.safe_load(WORKFLOWS[0].read_text(encoding="utf-8"))
+    commands = [s["run"].strip() for s in _steps(workflow) if "run" in s]
+    project = [c for c in commands if c.startswith(PROJECT_COMMANDS)]
+    assert "snakemake --cores 2" in project and "python -m pytest" in project
+    assert 'pip install -e ".[test]"' in project
+    missing = [c for c in project if c not in readme]
+    assert not missing, f"commands of the workflow that the README does not give: {missing}"
+    uploads = [s for s in _steps(workflow) if s.get("uses", "").startswith("actions/upload")]
+    assert {u["with"]["name"] for u in uploads} == {"paper-run", "paper-run-extras"}
+    for upload in uploads:
+        assert "results/paper/article.pdf" in upload["with"]["path"]
+        assert upload["with"]["name"] in readme  # the README says how to get it
