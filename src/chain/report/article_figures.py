@@ -28,7 +28,7 @@ FIGURE_SECTIONS = {
     "fig5_ssw_vs_force": "ssw",
     "ssw_spacetime": "ssw",
     "fig_parity_ssw_vs_N": "ssw",
-    "fig_ssw_mechanisms": "mechanisms",
+    "fig_ssw_mechanisms": "ssw",
 }
 
 #: What to see in each figure (the article's own words); numbers are added by
