@@ -17,7 +17,7 @@ import pandas as pd
 from chain.analysis.regression import fit_power_law, ratio_with_error
 from chain.analysis.rows import is_ok
 from chain.report.paper import PAPER_ENERGY_DRIFT
-from chain.report.printed import fixed, percent, plus_minus, scientific
+from chain.report.printed import fixed, percent, plus_minus, plus_minus_stat_sys, scientific
 
 #: When a number of ours "agrees" with the paper's claim. Relative for C, absolute for
 #: exponents; printed in the article beside the table.
@@ -268,11 +268,11 @@ def _stat(fit) -> float:
 
 
 def _pct(fit) -> str:
-    """'(3.43 ± 0.00 stat ± 2.07 sys) % of F_m'."""
-    text = f"({fixed(100 * fit['slope'], 2)} ± {fixed(100 * _stat(fit), 2)} stat"
-    if fit.get("slope_sys") is not None:
-        text += f" ± {fixed(100 * fit['slope_sys'], 2)} sys"
-    return text + ") % of F_m"
+    """'(3.4 ± < 0.1 (stat) ± 2.1 (sys)) % of F_m' (:mod:`chain.report.printed`)."""
+    if fit.get("slope_sys") is None:
+        return f"({plus_minus(100 * fit['slope'], 100 * _stat(fit))}) % of F_m"
+    parts = (100 * fit["slope"], 100 * _stat(fit), 100 * fit["slope_sys"])
+    return f"({plus_minus_stat_sys(*parts)}) % of F_m"
 
 
 def _proportional_claim(summary, source, model, group, fits) -> dict:
