@@ -49,7 +49,7 @@ def friction_sentence(table: pd.DataFrame, mechanism: str) -> str:
         parts.append(
             f"N = {n_beads}: {_span(group['ratio_to_frictionless'].astype(float))} times "
             f"the frictionless SSW/F_m, C {c0:.1f} -> {_span(group['C'].astype(float))} "
-            "us N^1/6"
+            "µs N^(1/6)"
         )
     best = frictional["ratio_to_frictionless"].astype(float).max()
     settings = "; ".join(dict.fromkeys(frictional["setting"]))
@@ -84,7 +84,7 @@ def candidate_sentence(table: pd.DataFrame, friction: str, reference: str) -> st
         f"N = {r.N}: {r.ratio_to_frictionless:.2f}" for r in chosen.itertuples(index=False)
     )
     c_text = ", ".join(
-        f"N = {r.N}: {_c_of(base, r.N):.1f} -> {r.C:.1f} us N^1/6"
+        f"N = {r.N}: {_c_of(base, r.N):.1f} -> {r.C:.1f} µs N^(1/6)"
         for r in chosen.itertuples(index=False)
     )
     return (
