@@ -73,6 +73,7 @@ FIGURES = [
     "fig_parity_ssw_vs_N",
     "ssw_spacetime",
     "fig_c_sensitivity",
+    "fig_ssw_mechanisms",
 ]
 
 

@@ -6,7 +6,7 @@ written to disk as CSV. Columns:
 =================  ======  ==========================================================
 column             type    meaning
 =================  ======  ==========================================================
-``source``         str     ``simulation`` or ``experiment``
+``source``         str     ``simulation``, ``experiment`` or ``lammps`` (the LAMMPS engine)
 ``model``          str     model name (``elastic``, ``viscoelastic``...) or dataset name
 ``N``              int     number of beads in the chain
 ``shot``           int     shot id, unique within the table
@@ -47,7 +47,7 @@ META_COLUMNS = (
     "v0_right_m_s",
     "t_s",
 )
-SOURCES = ("simulation", "experiment")
+SOURCES = ("simulation", "experiment", "lammps")
 KINDS = ("collision", "reference")
 _SENSOR_COLUMN = re.compile(r"^force_bead(\d+)_N$")
 

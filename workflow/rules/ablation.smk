@@ -17,7 +17,8 @@ rule ablation_variant:
     input:
         code("ablation_variant"),
     output:
-        f"{OUT}/ablation/{{variant}}_fits.csv",
+        fits=f"{OUT}/ablation/{{variant}}_fits.csv",
+        ssw_fits=f"{OUT}/ablation/{{variant}}_ssw_fits.csv",
     log:
         f"{LOGS}/ablation/{{variant}}.log",
     benchmark:

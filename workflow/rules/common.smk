@@ -2,6 +2,7 @@
 # depends on, and the lists of targets. Other rule files only use names from here.
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,17 @@ from chain.pipeline.deps import script_sources
 from chain.pipeline.resources import simulation_needs, simulation_threads
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
+from chain.physics.lammps_engine import lammps_available
+from chain.pipeline.mechanisms import (
+    CANDIDATE_REFERENCE,
+    FRICTION_MECHANISM,
+    REFERENCE_MECHANISM,
+    candidate_variants,
+    setting_label,
+    sweep_settings,
+    viscous_settings,
+    VISCOUS_MECHANISM,
+)
 from chain.pipeline.ablation import (
     ablation_variants,
     overrides_text,
@@ -220,6 +232,8 @@ def figure_names():
         names.append("fig_parity_ssw_vs_N")
     if config["figures"]["sweep_vs_N"]:
         names.append("fig_c_vs_N")
+    if MECHANISM_TABLES:
+        names.append("fig_ssw_mechanisms")
     return names
 
 
@@ -241,6 +255,8 @@ def final_targets(wildcards=None):
         + [f"{OUT}/summary.json", f"{OUT}/summary.md"]
         + [f"{OUT}/article.pdf"]
         + ([f"{TABLES}/sweep.csv"] if config["figures"]["sweep_vs_N"] else [])
+        + LAMMPS_TARGETS
+        + MECHANISM_TABLES
     )
 
 
@@ -322,8 +338,17 @@ ABLATION = {v["name"]: v for v in ablation_variants(config)}
 # tables/ablation_exponent.csv and the summary; `snakemake ablation` runs them all into
 # tables/ablation_exponent_all.csv. Only with the virtual experiment.
 VIRTUAL_RUN = config["experiment"]["source"] == "virtual"
+# Variants that name a mechanism (and their reference) belong to the mechanism study
+# (config mechanism_study; tables/ssw_mechanisms.csv), not to this table's verdict.
+STUDY = config.get("mechanism_study", True)
 ABLATION_DEFAULT = (
-    [n for n, v in ABLATION.items() if v["default_run"]] if VIRTUAL_RUN else []
+    [
+        n
+        for n, v in ABLATION.items()
+        if v["default_run"] and not v["mechanism"] and n != CANDIDATE_REFERENCE
+    ]
+    if VIRTUAL_RUN
+    else []
 )
 ABLATION_TABLES = [f"{TABLES}/ablation_exponent.csv"] if ABLATION_DEFAULT else []
 
@@ -355,3 +380,67 @@ def ablation_names(which):
 
 def ablation_fit_files(which):
     return [f"{OUT}/ablation/{name}_fits.csv" for name in ablation_names(which)]
+
+
+# ---- the mechanism study on LAMMPS (rules in mechanisms.smk) ---------------------
+# LAMMPS is an optional extra: its rules join the default run when it is importable,
+# and the console says so when it is not (here, before any job).
+LAMMPS = STUDY and lammps_available()
+if STUDY and not LAMMPS:
+    print(
+        "hertzchain: LAMMPS is not importable, so the LAMMPS rules are skipped "
+        "(tables/lammps_check.csv; the friction/rotation and viscous rows of "
+        "tables/ssw_mechanisms.csv, which keeps the virtual experiment's candidates); "
+        'install them with  pip install -e ".[lammps]"',
+        file=sys.stderr,
+    )
+# The config keys the LAMMPS jobs read (chain.pipeline.mechanisms).
+MECHANISM_CONFIG = {
+    key: config[key]
+    for key in ("material", "radius_m", "chains", "models", "lammps")
+    if key in config
+}
+SWEEP_DEFAULT = sweep_settings(config, full=False)
+SWEEP_ALL = sweep_settings(config, full=True)
+# The viscous inter-bead settings (instead of Kuwabara-Kono, frictionless track).
+VISCOUS = {
+    "": viscous_settings(config, full=False),
+    "_all": viscous_settings(config, full=True),
+}
+FRICTIONLESS = next(iter(SWEEP_DEFAULT))
+# The candidates of the virtual experiment (ablation variants with a mechanism).
+CANDIDATES = {
+    which: (
+        candidate_variants(list(ABLATION.values()), which == "_all")
+        if VIRTUAL_RUN and STUDY
+        else {}
+    )
+    for which in ("", "_all")
+}
+LAMMPS_TARGETS = [f"{TABLES}/lammps_check.csv"] if LAMMPS else []
+MECHANISM_TABLES = [f"{TABLES}/ssw_mechanisms.csv"] if LAMMPS or CANDIDATES[""] else []
+
+
+wildcard_constraints:
+    setting="|".join([*SWEEP_ALL, *VISCOUS["_all"]]),
+
+
+def setting_files(which, what):
+    """Per-(setting, chain) outputs of the sweep (``what``; ``viscous_<what>`` for the
+    viscous settings): "" the default run's, "_all" all; none without LAMMPS."""
+    if not LAMMPS:
+        return []
+    settings = SWEEP_ALL if which == "_all" else SWEEP_DEFAULT
+    if what.startswith("viscous_"):
+        settings, what = VISCOUS[which], what.removeprefix("viscous_")
+    return [f"{OUT}/lammps/{name}_N{n}_{what}.csv" for name in settings for n in CHAINS]
+
+
+def candidates_of(which):
+    """Variant name -> [mechanism, setting] of the candidates of ssw_mechanisms<which>."""
+    return {name: list(value) for name, value in CANDIDATES[which].items()}
+
+
+def candidate_files(which, what):
+    """The candidates' ablation outputs (_fits or _ssw_fits), in candidates_of order."""
+    return [f"{OUT}/ablation/{name}_{what}.csv" for name in CANDIDATES[which]]

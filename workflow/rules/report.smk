@@ -7,6 +7,8 @@ rule summary:
         ssw_fits=f"{TABLES}/ssw_fits.csv",
         c_sensitivity=f"{TABLES}/c_sensitivity.csv",
         ablation=ABLATION_TABLES,
+        mechanisms=MECHANISM_TABLES,
+        lammps_check=LAMMPS_TARGETS,
         pulses=f"{TABLES}/pulses.csv",
         delays=f"{TABLES}/delays.csv",
         ssw=f"{TABLES}/ssw.csv",
@@ -30,6 +32,8 @@ rule summary:
         estimator=config["analysis"]["main_estimator"],
         experiment_label=experiment_label,
         tolerance=config["experiment"]["tolerance"],
+        friction_mechanism=FRICTION_MECHANISM,
+        reference_mechanism=REFERENCE_MECHANISM,
     script:
         "../scripts/summary.py"
 

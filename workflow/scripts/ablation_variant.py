@@ -1,17 +1,22 @@
-"""One ablation variant of the virtual experiment (a model), all its replicates
-(chain.pipeline.ablation.run_variant)."""
+"""One ablation variant of the virtual experiment (a model), all its replicates: delay
+fits (chain.pipeline.ablation) and SSW fits at S2 (chain.pipeline.mechanisms)."""
 
 import pandas as pd
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.ablation import run_variant
+from chain.pipeline.ablation import run_variant_shots, variant_delay_fits
+from chain.pipeline.mechanisms import variant_ssw_fits
 
 log = start(snakemake)
 p = snakemake.params
-tables = []
+tables, ssw_tables = [], []
 for replicate, chains in enumerate(p.settings):
-    fits = run_variant(chains, p.tolerance, p.estimators, series=p.series)
+    traces, pulses, selection = run_variant_shots(
+        chains, p.tolerance, p.estimators, series=p.series
+    )
+    fits = variant_delay_fits(pulses, selection)
+    ssw_fits = variant_ssw_fits(traces, pulses, selection, p.estimators[0])
     seeds = [c["seed"] for c in chains]
     pooled = fits[fits["N"].astype(str) == "pooled"].iloc[0]
     log.info(
@@ -25,4 +30,6 @@ for replicate, chains in enumerate(p.settings):
         pooled["exponent_stderr"],
     )
     tables.append(fits.assign(replicate=replicate, seeds=" ".join(map(str, seeds))))
-write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output[0])
+    ssw_tables.append(ssw_fits.assign(replicate=replicate))
+write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output.fits)
+write_csv_atomic(pd.concat(ssw_tables, ignore_index=True), snakemake.output.ssw_fits)

@@ -4,6 +4,7 @@ import pandas as pd
 from _inputs import selection
 from _logging import start
 
+from chain.report.mechanisms import mechanism_summary
 from chain.report.spread import ablation_summary, c_spread_summary
 from chain.report.summary import build_summary, write_summary_json
 
@@ -35,6 +36,15 @@ if snakemake.input.get("ablation"):
         p.estimator,
     )
 summary["c_spread"] = c_spread_summary(pd.read_csv(snakemake.input.c_sensitivity))
+# Issue 24: the mechanism study's verdict (LAMMPS rows only where LAMMPS is installed).
+if snakemake.input.get("mechanisms"):
+    check = snakemake.input.get("lammps_check")
+    summary["ssw_mechanisms"] = mechanism_summary(
+        pd.read_csv(snakemake.input.mechanisms[0]),
+        pd.read_csv(check[0]) if check else None,
+        friction=p.friction_mechanism,
+        reference=p.reference_mechanism,
+    )
 write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])

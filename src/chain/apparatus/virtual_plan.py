@@ -63,8 +63,8 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
                     "collision",
                     a,
                     speed(speeds[a], left_draw),
-                    speed(speeds[a], right_draw),
-                    settings.timing_jitter_s * delay_draw,
+                    speed(speeds[a], right_draw) * (1.0 + settings.right_speed_offset),
+                    settings.right_delay_s + settings.timing_jitter_s * delay_draw,
                     collision_phase[a, c],
                 )
             )

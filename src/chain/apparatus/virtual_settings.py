@@ -28,6 +28,13 @@ from chain.labels import VIRTUAL_LABEL
 from chain.physics.materials import Material, get_material
 from chain.physics.model import PAPER_BEAD_RADIUS, PAPER_STRIKER_RADIUS, PCB_200B02_STIFFNESS
 
+#: Stream number of the per-chain draws (bead radii, gaps): default_rng((seed, this)),
+#: independent of the shot draws of default_rng(seed).
+CHAIN_STREAM = 24
+
+#: Fields drawn once per chain (non-negative).
+_CHAIN_FIELDS = ("radius_dispersion", "gap_mean_m", "gap_spread_m")
+
 #: Default nominal impact speeds, m/s: incident amplitudes of about 9-90 N at the first
 #: sensor of the paper's chains (drop heights 8 mm to 32 cm).
 DEFAULT_IMPACT_SPEEDS_M_S = (0.4, 0.6, 0.8, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -96,6 +103,19 @@ class VirtualExperiment:
     reference_speed_mismatch : float or None
         Relative standard deviation of the reference shots' striker speed; None: the
         same as ``speed_mismatch``. The random draws are the same whatever the value.
+    radius_dispersion : float
+        Relative standard deviation of the bead radii (dimensionless; 0: equal beads).
+        Each bead's radius is R (1 + s e), e standard normal, its mass and its contacts'
+        stiffness follow; drawn once per chain (one set of beads for every shot), from
+        ``default_rng((seed, CHAIN_STREAM))``, so the shot draws are unchanged.
+    gap_mean_m, gap_spread_m : float
+        Mean and standard deviation of the gap between neighbouring beads at rest, m
+        (0: barely touching); gap k = max(0, mean + spread e), once per chain as above.
+    right_speed_offset : float
+        Systematic relative excess of the right striker's speed over the left one's
+        (dimensionless; an amplitude mismatch that moves the collision point).
+    right_delay_s : float
+        Systematic delay of the right launch after the left one, s (added to the jitter).
     """
 
     n_beads: int = 25
@@ -123,6 +143,11 @@ class VirtualExperiment:
     readout: str = "sensor"
     launch: str = "striker"
     reference_speed_mismatch: float | None = None
+    radius_dispersion: float = 0.0
+    gap_mean_m: float = 0.0
+    gap_spread_m: float = 0.0
+    right_speed_offset: float = 0.0
+    right_delay_s: float = 0.0
 
     def __post_init__(self) -> None:
         # Checked in field order; lists from a config become tuples (the dataclass is
@@ -134,8 +159,18 @@ class VirtualExperiment:
             get_material(self.material)
         for name in ("radius", "striker_radius", "sensor_stiffness", "sampling_interval_s"):
             require_positive(name, getattr(self, name))
-        for name in ("eta", "drag_rate", "timing_jitter_s", "noise_N"):
+        for name in ("eta", "drag_rate", "timing_jitter_s", "noise_N", *_CHAIN_FIELDS):
             require_nonnegative(name, getattr(self, name))
+        if self.radius_dispersion >= 0.1:
+            raise ParameterError(
+                f"radius_dispersion is a relative std < 0.1, got {self.radius_dispersion}"
+            )
+        if not -0.5 < self.right_speed_offset < 0.5:
+            raise ParameterError(
+                f"right_speed_offset is a relative excess in (-0.5, 0.5), "
+                f"got {self.right_speed_offset}"
+            )
+        require_nonnegative("right_delay_s", self.right_delay_s)
         sensitivity = _checked_sensitivity(self.sensitivity_mV_per_N, len(beads))
         object.__setattr__(self, "sensitivity_mV_per_N", sensitivity)
         for name, values in _checked_amplitudes(self.impact_speeds_m_s, self.drop_heights_m):

@@ -3,13 +3,15 @@ batch by batch, read at the sensors (a MODEL; see :mod:`chain.apparatus.virtual`
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 import pandas as pd
 
-from chain.apparatus.virtual_settings import VirtualExperiment, check_switches
-from chain.physics.model import uniform_chain
+from chain.apparatus.virtual_settings import CHAIN_STREAM, VirtualExperiment, check_switches
+from chain.physics.materials import contact_stiffness, sphere_mass
+from chain.physics.model import ChainModel, Striker, build_chain, uniform_chain
 from chain.physics.simulation import default_time_step, felt_contacts, simulate
 
 #: The virtual experiment integrates with this many times the conservative default step
@@ -49,7 +51,67 @@ def _initial_displacement(model, plan: pd.DataFrame) -> np.ndarray:
     return displacement
 
 
-def _sensor_forces(settings, model, plan, dt, record_interval):
+def chain_draws(settings: VirtualExperiment) -> tuple[np.ndarray, np.ndarray]:
+    """The chain's own imperfections, drawn once per chain: (bead radii (N,) m, gaps at
+    rest between neighbours (N-1,) m), from ``default_rng((seed, CHAIN_STREAM))``.
+
+    Both are always drawn, in this order, so that each is the same whatever the other's
+    setting; with zero dispersion and gaps they are R and 0 exactly.
+    """
+    rng = np.random.default_rng((settings.seed, CHAIN_STREAM))
+    n_beads = settings.n_beads
+    radii = settings.radius * (1.0 + settings.radius_dispersion * rng.standard_normal(n_beads))
+    gaps = settings.gap_mean_m + settings.gap_spread_m * rng.standard_normal(n_beads - 1)
+    return radii, np.maximum(gaps, 0.0)
+
+
+def apparatus_chain(settings: VirtualExperiment, strikers: str, radii) -> ChainModel:
+    """The apparatus model with strikers at ``strikers`` ("both" or "left"): equal beads
+    (:func:`uniform_chain`) unless ``radii`` (N,) m differ, then each bead with its own
+    mass and each contact with its own Hertz stiffness."""
+    material = settings.material_object
+    common = dict(
+        eta=settings.eta,
+        sensor_beads=settings.sensor_beads if settings.readout == "sensor" else (),
+        sensor_stiffness=settings.sensor_stiffness,
+        drag_rate=settings.drag_rate,
+    )
+    with_strikers = settings.launch == "striker"
+    if np.all(radii == settings.radius):
+        return uniform_chain(
+            settings.n_beads,
+            material=material,
+            radius=settings.radius,
+            striker_radius=settings.striker_radius if with_strikers else None,
+            strikers=strikers,
+            **common,
+        )
+
+    def striker(bead_radius):
+        return Striker.sphere(settings.striker_radius, material, bead_radius, material)
+
+    return build_chain(
+        [sphere_mass(material, r) for r in radii],
+        [contact_stiffness(material, a, material, b) for a, b in itertools.pairwise(radii)],
+        left_striker=striker(radii[0]) if with_strikers else None,
+        right_striker=striker(radii[-1]) if with_strikers and strikers == "both" else None,
+        **common,
+    )
+
+
+def rest_displacement(model: ChainModel, gaps) -> np.ndarray:
+    """Particle displacements (P,) m that open ``gaps`` (N-1,) m between the beads at
+    rest: every bead shifted right by the gaps to its left; strikers touch their bead."""
+    offset = np.concatenate([[0.0], np.cumsum(gaps)])
+    displacement = np.zeros(model.n_particles)
+    for bead, (first, last) in enumerate(zip(model.bead_first, model.bead_last)):
+        displacement[first : last + 1] = offset[bead]
+    if model.right_striker >= 0:
+        displacement[model.right_striker] = offset[-1]
+    return displacement
+
+
+def _sensor_forces(settings, model, plan, dt, record_interval, rest):
     """Simulated sensor forces of the shots in ``plan``: (time (S,), forces (B, n, S))."""
     time = None
     chunks = []
@@ -62,7 +124,7 @@ def _sensor_forces(settings, model, plan, dt, record_interval):
             duration=settings.duration_s,
             dt=dt,
             record_interval=record_interval,
-            initial_displacement=_initial_displacement(model, part),
+            initial_displacement=_initial_displacement(model, part) + rest,
             # Record only what the readout reads (sensor springs are always kept).
             contacts=(
                 felt_contacts(model, settings.sensor_beads) if settings.readout == "felt" else ()
@@ -93,18 +155,9 @@ def simulate_virtual_shots(
         Sensor readings of every shot of ``plan``, in plan order.
     """
     check_switches(settings)
-    material = settings.material_object
-    common = dict(
-        material=material,
-        radius=settings.radius,
-        eta=settings.eta,
-        sensor_beads=settings.sensor_beads if settings.readout == "sensor" else (),
-        sensor_stiffness=settings.sensor_stiffness,
-        striker_radius=settings.striker_radius if settings.launch == "striker" else None,
-        drag_rate=settings.drag_rate,
-    )
-    both = uniform_chain(settings.n_beads, strikers="both", **common)
-    left = uniform_chain(settings.n_beads, strikers="left", **common)
+    radii, gaps = chain_draws(settings)
+    both = apparatus_chain(settings, "both", radii)
+    left = apparatus_chain(settings, "left", radii)
     record_interval = settings.sampling_interval_s / RECORD_OVERSAMPLING
     fastest = float(plan[["v_left_m_s", "v_right_m_s"]].to_numpy().max())
     dt = settings.time_step_s or TIME_STEP_COARSENING * default_time_step(both, fastest)
@@ -116,7 +169,9 @@ def simulate_virtual_shots(
         rows = np.flatnonzero(plan["kind"].to_numpy() == kind)
         if rows.size == 0:
             continue
-        time, kind_forces = _sensor_forces(settings, model, plan.iloc[rows], dt, record_interval)
+        time, kind_forces = _sensor_forces(
+            settings, model, plan.iloc[rows], dt, record_interval, rest_displacement(model, gaps)
+        )
         if forces.shape[2] == 0:
             forces = np.empty((len(plan), len(settings.sensor_beads), time.size))
         forces[rows] = kind_forces

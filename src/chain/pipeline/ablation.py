@@ -65,7 +65,8 @@ ABLATION_COLUMNS = (
 
 def ablation_variants(config: Mapping) -> list[dict]:
     """The variants of a schema-valid config: name, description, replicates,
-    default_run, set."""
+    default_run, set, mechanism ("" unless the variant is a candidate of the mechanism
+    study, tables/ssw_mechanisms.csv)."""
     variants = config.get("ablation", {}).get("variants", [])
     return [
         {
@@ -74,6 +75,7 @@ def ablation_variants(config: Mapping) -> list[dict]:
             "replicates": int(v.get("replicates", 1)),
             "default_run": bool(v.get("default_run", False)),
             "set": dict(v.get("set") or {}),
+            "mechanism": v.get("mechanism") or "",
         }
         for v in variants
     ]
@@ -162,11 +164,7 @@ def run_variant(
     series: str = VIRTUAL_SERIES,
 ) -> pd.DataFrame:
     """Run the virtual experiment on each chain, analyse it as the pipeline does, and
-    fit |Delta| against F_m.
-
-    The shots go through the measured-data path (written in the measured-trace format
-    to a temporary folder and loaded back), pulses are fitted per chain, collisions are
-    selected with ``tolerance`` and the delays fitted pooled and per chain.
+    fit |Delta| against F_m (:func:`run_variant_shots`, then :func:`variant_delay_fits`).
 
     Parameters
     ----------
@@ -184,25 +182,57 @@ def run_variant(
     DataFrame
         :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
     """
+    _, pulses, selection = run_variant_shots(settings_per_chain, tolerance, estimators, series)
+    return variant_delay_fits(pulses, selection)
+
+
+def run_variant_shots(
+    settings_per_chain: Sequence[Mapping],
+    tolerance: float | None,
+    estimators: Sequence[str] = ("fit_full",),
+    series: str = VIRTUAL_SERIES,
+) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
+    """Run the virtual experiment on each chain and fit its pulses and select its shots
+    as the pipeline does (parameters as :func:`run_variant`).
+
+    The shots go through the measured-data path (written in the measured-trace format
+    to a temporary folder and loaded back), pulses are fitted per chain and collisions
+    are selected with ``tolerance``.
+
+    Returns
+    -------
+    traces : list of DataFrame
+        The trace table of each chain.
+    pulses : DataFrame
+        Their pulse rows (:func:`chain.analysis.pulse_rows.pulse_table`).
+    selection : DataFrame or None
+        The shot selection (None with ``tolerance`` None).
+    """
     # Imported here: chain.apparatus pulls in the simulation core, and the pulse fits
     # scipy.signal, which the ablation table job (it only reads fits) does not need.
     from chain.analysis.pulse_rows import pulse_table
     from chain.apparatus.measured import load_dataset
     from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 
-    pulses = []
+    pulses, traces = [], []
     with tempfile.TemporaryDirectory(prefix="ablation.") as folder:
         for i, fields in enumerate(settings_per_chain):
             settings = VirtualExperiment.from_dict(fields)
             dataset = Path(folder) / f"chain{i}"
             run_virtual_experiment(settings, dataset, series)
-            traces = load_dataset(dataset, name=series)
-            pulses.append(pulse_table(traces, estimators=tuple(estimators)))
+            traces.append(load_dataset(dataset, name=series))
+            pulses.append(pulse_table(traces[-1], estimators=tuple(estimators)))
     table = pd.concat(pulses, ignore_index=True)
     selection = None
     if tolerance is not None:
         selection = select_shots(table, tolerance, estimator=estimators[0])
-    delays = delay_table(table, selection=selection)
+    return traces, table, selection
+
+
+def variant_delay_fits(pulses: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
+    """|Delta| = C F_m^(-1/6) and the free power law, pooled and per chain, of the pulses
+    of :func:`run_variant_shots` (:func:`chain.analysis.delays.delay_fit_table` rows)."""
+    delays = delay_table(pulses, selection=selection)
     return delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))
 
 

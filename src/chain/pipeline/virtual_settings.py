@@ -34,6 +34,11 @@ VIRTUAL_FIELDS = {
     "readout": "readout",
     "launch": "launch",
     "reference_speed_mismatch": "reference_speed_mismatch",
+    "radius_dispersion": "radius_dispersion",
+    "gap_mean_m": "gap_mean_m",
+    "gap_spread_m": "gap_spread_m",
+    "right_speed_offset": "right_speed_offset",
+    "right_delay_s": "right_delay_s",
 }
 
 

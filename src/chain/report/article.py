@@ -96,12 +96,13 @@ def findings(summary: Mapping) -> dict:
     """The SSW, ablation and C-spread findings of the run, printed, or None each.
 
     Reads the summary keys ``ssw_resolved``, ``ssw_separation``, ``ssw_parity_ratio``,
-    ``ssw_far_field``,
-    ``ablation`` ({verdict, rows}) and ``c_spread`` ({headline_choice, min_us_N16,
-    max_us_N16, rows}); an absent or empty key gives None.
+    ``ssw_far_field``, ``ablation`` ({verdict, rows}), ``ssw_mechanisms`` ({verdict,
+    rows, lammps_check}) and ``c_spread`` ({headline_choice, min_us_N16, max_us_N16,
+    rows}); an absent or empty key gives None.
     """
     resolved = summary.get("ssw_resolved") or None
     ablation = summary.get("ablation") or None
+    study = summary.get("ssw_mechanisms") or None
     spread = summary.get("c_spread") or None
     return {
         "ssw_resolved": table_of(resolved),
@@ -120,6 +121,13 @@ def findings(summary: Mapping) -> dict:
             "verdict": str(ablation.get("verdict", "")),
             "tables": ablation_tables(ablation.get("rows")),
         },
+        "mechanisms": None
+        if study is None
+        else {
+            "verdict": str(study.get("verdict", "")),
+            "table": table_of(study.get("rows")),
+            "check": table_of(_check_rows(study.get("lammps_check"))),
+        },
         "c_spread": None
         if spread is None
         else {
@@ -129,6 +137,24 @@ def findings(summary: Mapping) -> dict:
             "tables": c_spread_tables(spread.get("rows")),
         },
     }
+
+
+def _check_rows(rows) -> list[dict] | None:
+    """The cross-check's rows as the article prints them: chain, model, both C, their
+    relative difference and the largest trace difference over F_m."""
+    if not rows:
+        return None
+    return [
+        {
+            "N": r["N"],
+            "model": r["model"],
+            "C kernel": r["C_kernel"],
+            "C LAMMPS": r["C_lammps"],
+            "C rel. diff.": r["rel_diff_C"],
+            "max |trace diff| / F_m": r["max_trace_diff_over_Fm"],
+        }
+        for r in rows
+    ]
 
 
 def _model_numbers(summary) -> list[dict]:

@@ -58,8 +58,11 @@ CAPTIONS = {
     "fig_c_sensitivity": "C, chains pooled, for each choice of estimator, dissipation η, "
     "sensor pair and amplitude range, one choice changed at a time from the headline.",
     "fig_c_vs_N": "C against the number of beads N of the chain, per model.",
-    "fig_ssw_mechanisms": "SSW amplitude over F_m at S2 for each candidate mechanism and "
-    "setting, against the frictionless line, N = 25 and N = 26.",
+    "fig_ssw_mechanisms": "SSW amplitude over F_m at S2 (models, not data) for each "
+    "candidate mechanism and setting, N = 25 and N = 26: LAMMPS with track and bead "
+    "friction and rotation, or a viscous inter-bead force, against the frictionless "
+    "chain; the virtual experiment's candidates against it as configured. Dashes: the "
+    "reference; dotted: twice it, the mark of significantly larger; n/r: no value.",
 }
 
 UNITS_C = "µs N^1/6"

@@ -18,6 +18,7 @@ from pathlib import Path
 from chain.analysis.selection import SKIPPED_REASON
 from chain.atomic import write_text_atomic
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
+from chain.report.mechanisms import mechanism_markdown
 from chain.report.paper import PAPER_ENERGY_DRIFT
 from chain.report.printed import plus_minus
 from chain.report.spread import spread_markdown_rows
@@ -96,6 +97,7 @@ def summary_markdown(summary: Mapping) -> str:
         "|---|---|---|---|",
     ]
     lines += [f"| {q} | {p} | {r} | {n} |" for q, p, r, n in rows]
+    lines += mechanism_markdown(summary)
     lines += ["", "Notes", "", *NOTES, *_attenuation_notes(summary), ""]
     return "\n".join(lines)
 

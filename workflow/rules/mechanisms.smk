@@ -1,0 +1,112 @@
+# The mechanism study (issue 24; models, not data), on the optional LAMMPS engine
+# (chain.physics.lammps_engine): the frictionless 1D cross-check against our kernel
+# (tables/lammps_check.csv), and the friction/rotation sweep (floor track, gravity,
+# track friction mu_t, bead-bead friction mu_b, rolling and twisting resistance), one
+# job per (setting, chain), analysed as every series (chain.pipeline.mechanisms), and
+# a viscous inter-bead force instead of Kuwabara-Kono on the frictionless track:
+# tables/ssw_mechanisms.csv and its figure. The default run runs
+# lammps.sweep.default_settings (~30 s on 2 cores); the whole mu_t x mu_b grid:
+# `snakemake --cores 2 mechanisms` (tables/ssw_mechanisms_all.csv). Without LAMMPS
+# these rules are left out of the default run (common.smk says so on the console).
+
+
+rule mechanisms:
+    input:
+        f"{TABLES}/ssw_mechanisms_all.csv",
+
+
+rule lammps_check:
+    input:
+        code("lammps_check"),
+    output:
+        f"{TABLES}/lammps_check.csv",
+    log:
+        f"{LOGS}/tables/lammps_check.log",
+    benchmark:
+        f"{BENCH}/tables/lammps_check.tsv"
+    conda:
+        ENV
+    params:
+        config=MECHANISM_CONFIG,
+        estimator=config["analysis"]["main_estimator"],
+    script:
+        "../scripts/lammps_check.py"
+
+
+rule lammps_setting:
+    input:
+        code("lammps_setting"),
+    output:
+        traces=f"{OUT}/lammps/{{setting}}_N{{N}}_traces.csv",
+        runs=f"{OUT}/lammps/{{setting}}_N{{N}}_runs.csv",
+        delay_fits=f"{OUT}/lammps/{{setting}}_N{{N}}_delay_fits.csv",
+        ssw_fits=f"{OUT}/lammps/{{setting}}_N{{N}}_ssw_fits.csv",
+    log:
+        f"{LOGS}/lammps/{{setting}}_N{{N}}.log",
+    benchmark:
+        f"{BENCH}/lammps/{{setting}}_N{{N}}.tsv"
+    conda:
+        ENV
+    params:
+        config=MECHANISM_CONFIG,
+        sensors=lambda wildcards: CHAINS[int(wildcards.N)]["sensors"],
+        estimator=config["analysis"]["main_estimator"],
+    script:
+        "../scripts/lammps_setting.py"
+
+
+# The default run's settings and candidates (tables/ssw_mechanisms.csv) and all of them
+# (tables/ssw_mechanisms_all.csv, target `mechanisms`): the LAMMPS rows when LAMMPS is
+# installed, the virtual experiment's candidates (ablation variants with a mechanism)
+# when the experiment is virtual.
+rule ssw_mechanisms:
+    input:
+        lammps_delay_fits=lambda wildcards: setting_files(wildcards.which, "delay_fits"),
+        lammps_ssw_fits=lambda wildcards: setting_files(wildcards.which, "ssw_fits"),
+        viscous_delay_fits=lambda wildcards: setting_files(
+            wildcards.which, "viscous_delay_fits"
+        ),
+        viscous_ssw_fits=lambda wildcards: setting_files(
+            wildcards.which, "viscous_ssw_fits"
+        ),
+        candidate_fits=lambda wildcards: candidate_files(wildcards.which, "fits"),
+        candidate_ssw_fits=lambda wildcards: candidate_files(
+            wildcards.which, "ssw_fits"
+        ),
+        lib=code("ssw_mechanisms"),
+    output:
+        f"{TABLES}/ssw_mechanisms{{which}}.csv",
+    log:
+        f"{LOGS}/tables/ssw_mechanisms{{which}}.log",
+    benchmark:
+        f"{BENCH}/tables/ssw_mechanisms{{which}}.tsv"
+    wildcard_constraints:
+        which="|_all",
+    conda:
+        ENV
+    params:
+        labels={name: setting_label(*pair) for name, pair in SWEEP_ALL.items()},
+        viscous_labels={
+            name: f"gamma={gamma:g} N s/m" for name, gamma in VISCOUS["_all"].items()
+        },
+        lammps_reference=FRICTIONLESS,
+        candidates=lambda wildcards: candidates_of(wildcards.which),
+        candidate_reference=CANDIDATE_REFERENCE,
+    script:
+        "../scripts/ssw_mechanisms.py"
+
+
+rule fig_ssw_mechanisms:
+    input:
+        table=f"{TABLES}/ssw_mechanisms.csv",
+        lib=code("fig_ssw_mechanisms"),
+    output:
+        **figure_outputs("fig_ssw_mechanisms"),
+    log:
+        f"{LOGS}/figures/fig_ssw_mechanisms.log",
+    benchmark:
+        f"{BENCH}/figures/fig_ssw_mechanisms.tsv"
+    conda:
+        ENV
+    script:
+        "../scripts/fig_ssw_mechanisms.py"

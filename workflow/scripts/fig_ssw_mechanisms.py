@@ -1,0 +1,15 @@
+"""The mechanism figure: SSW/F_m at S2 per mechanism and setting
+(chain.report.fig_ssw_mechanisms)."""
+
+from pathlib import Path
+
+import pandas as pd
+from _logging import start
+
+from chain.report.fig_ssw_mechanisms import fig_ssw_mechanisms
+from chain.report.style import save_figure
+
+log = start(snakemake)
+fig = fig_ssw_mechanisms(pd.read_csv(snakemake.input.table))
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+log.info("done")

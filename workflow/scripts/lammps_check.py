@@ -1,0 +1,20 @@
+"""LAMMPS against our kernel in the frictionless 1D limit (chain.pipeline.mechanisms)."""
+
+from _logging import start
+
+from chain.atomic import write_csv_atomic
+from chain.pipeline.mechanisms import run_lammps_check
+
+log = start(snakemake)
+table = run_lammps_check(snakemake.params.config, snakemake.params.estimator)
+for row in table.itertuples(index=False):
+    log.info(
+        "N = %d %s: C kernel %.6f, LAMMPS %.6f (rel %.2g); traces within %.2g F_m",
+        row.N,
+        row.model,
+        row.C_kernel,
+        row.C_lammps,
+        row.rel_diff_C,
+        row.max_trace_diff_over_Fm,
+    )
+write_csv_atomic(table, snakemake.output[0])

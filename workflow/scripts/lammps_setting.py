@@ -1,0 +1,28 @@
+"""One friction/rotation setting on one chain, run by LAMMPS and analysed
+(chain.pipeline.mechanisms.run_sweep_setting)."""
+
+from _logging import start
+
+from chain.atomic import write_csv_atomic
+from chain.pipeline.mechanisms import run_sweep_setting
+from chain.traces import write_traces
+
+log = start(snakemake)
+w = snakemake.wildcards
+out = run_sweep_setting(
+    snakemake.params.config,
+    int(w.N),
+    snakemake.params.sensors,
+    w.setting,
+    snakemake.params.estimator,
+)
+write_traces(out["traces"], snakemake.output.traces)
+for name in ("runs", "delay_fits", "ssw_fits"):
+    write_csv_atomic(out[name], snakemake.output[name])
+log.info(
+    "%s N = %s: largest bead spin %.3g rad/s; SSW slopes %s",
+    w.setting,
+    w.N,
+    out["runs"]["max_spin_rad_s"].max(),
+    out["ssw_fits"]["slope"].tolist(),
+)

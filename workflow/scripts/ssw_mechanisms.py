@@ -1,0 +1,52 @@
+"""tables/ssw_mechanisms.csv: SSW/F_m at S2 and C per mechanism and setting: the LAMMPS
+friction/rotation sweep and the virtual experiment's candidates
+(chain.pipeline.mechanisms)."""
+
+import pandas as pd
+from _logging import start
+
+from chain.atomic import write_csv_atomic
+from chain.pipeline.mechanisms import (
+    FRICTION_MECHANISM,
+    VISCOUS_MECHANISM,
+    candidate_rows,
+    mechanism_rows,
+)
+
+log = start(snakemake)
+p = snakemake.params
+i = snakemake.input
+tables = []
+if i.lammps_delay_fits:
+    tables.append(
+        mechanism_rows(
+            FRICTION_MECHANISM,
+            p.labels,
+            [pd.read_csv(path) for path in i.lammps_delay_fits],
+            [pd.read_csv(path) for path in i.lammps_ssw_fits],
+            p.lammps_reference,
+        )
+    )
+if i.viscous_delay_fits:
+    tables.append(
+        mechanism_rows(
+            VISCOUS_MECHANISM,
+            p.viscous_labels,
+            [pd.read_csv(path) for path in [*i.lammps_delay_fits, *i.viscous_delay_fits]],
+            [pd.read_csv(path) for path in [*i.lammps_ssw_fits, *i.viscous_ssw_fits]],
+            p.lammps_reference,
+        )
+    )
+if p.candidates:
+    names = list(p.candidates)
+    tables.append(
+        candidate_rows(
+            {name: tuple(value) for name, value in p.candidates.items()},
+            dict(zip(names, map(pd.read_csv, i.candidate_fits))),
+            dict(zip(names, map(pd.read_csv, i.candidate_ssw_fits))),
+            p.candidate_reference,
+        )
+    )
+table = pd.concat(tables, ignore_index=True)
+log.info("%d rows", len(table))
+write_csv_atomic(table, snakemake.output[0])
