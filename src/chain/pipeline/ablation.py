@@ -31,7 +31,7 @@ from chain.analysis.selection import select_shots
 from chain.errors import ParameterError
 from chain.errors import key_label as key_name
 from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
-from chain.pipeline.virtual_settings import (
+from chain.pipeline.virtual_config import (
     VIRTUAL_FIELDS,
     ConfigError,
     virtual_experiment_settings,

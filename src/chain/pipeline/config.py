@@ -57,7 +57,7 @@ from chain.physics.theory import (
 )
 
 # Re-exported: the config checks and the rules name them from here.
-from chain.pipeline.virtual_settings import (  # noqa: F401
+from chain.pipeline.virtual_config import (  # noqa: F401
     VIRTUAL_FIELDS,
     ConfigError,
     virtual_experiment_settings,

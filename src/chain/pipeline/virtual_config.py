@@ -1,4 +1,5 @@
-"""The virtual experiment's settings from a config, and the error a bad config raises.
+"""The virtual experiment's settings from a config (config keys -> VirtualExperiment
+fields, chain.apparatus.virtual_settings), and the error a bad config raises.
 
 Its own module so that both :mod:`chain.pipeline.config` (the checks) and
 :mod:`chain.pipeline.ablation` (the variants) use it without importing each other.
