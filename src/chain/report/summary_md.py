@@ -31,9 +31,11 @@ NOTES = [
     "* Δ = TOF(crossed) − TOF(reference) between the two sensors; |Δ| is fitted. In a "
     "simulation the LSTW and RSTW points are mirror images and count twice, so their "
     "standard errors are about √2 too small.",
-    "* The simulation has no track friction; the paper attributes the small difference "
-    "between its measured and simulated Δ to friction lengthening the pulses, and the "
-    "large measured SSW to bead rotation and friction, neither of which is modelled.",
+    "* The simulation (Eq. 1) has no track friction; the paper attributes the small "
+    "difference between its measured and simulated Δ to friction lengthening the pulses, "
+    "and the large measured SSW to bead rotation and friction. The mechanism study (3D "
+    "beads with rotation and friction on LAMMPS, and the other candidates in the virtual "
+    "apparatus) tests the second; its verdict is above when this run has it.",
     "* The paper states that viscoelastic dissipation leaves Δ unchanged (Sec. V); the "
     "rows C(model) / C(conservative model) test that on this run.",
     "* SSW at a sensor: the largest residual against the self-similar template behind the "
