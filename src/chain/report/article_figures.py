@@ -28,7 +28,7 @@ FIGURE_SECTIONS = {
     "fig5_ssw_vs_force": "ssw",
     "ssw_spacetime": "ssw",
     "fig_parity_ssw_vs_N": "ssw",
-    "fig_ssw_mechanisms": "ssw",
+    "fig_ssw_mechanisms": "mechanisms",
 }
 
 #: What to see in each figure (the article's own words); numbers are added by
@@ -225,14 +225,6 @@ def _paragraph_ssw(summary: Mapping) -> str:
     )
 
 
-def _paragraph_mechanisms(summary: Mapping) -> str:
-    return (
-        "compares the SSW of each candidate mechanism for the paper's excess SSW "
-        "(friction on the track, rotation of the beads and the one-dimensional candidates) "
-        "with that of the frictionless chain; the numbers are in tables/ssw_mechanisms.csv."
-    )
-
-
 #: The paragraph that discusses a supplementary figure (its section's text does not).
 PARAGRAPHS: dict[str, Callable[[Mapping], str]] = {
     "fig_c_sensitivity": _paragraph_sensitivity,
@@ -244,7 +236,6 @@ PARAGRAPHS: dict[str, Callable[[Mapping], str]] = {
     "fig5_ssw_vs_force": _paragraph_ssw,
     "ssw_spacetime": _paragraph_spacetime,
     "fig_parity_ssw_vs_N": _paragraph_slopes,
-    "fig_ssw_mechanisms": _paragraph_mechanisms,
 }
 
 
