@@ -134,6 +134,21 @@ def test_slurm_profile_gives_jobs_their_resources():
     assert re.search(r"mem_mb=\d+00,.*runtime=\d+.*cpus_per_task=1", simulate), simulate
     fig1 = out[out.index("rule fig1_setup:") :].split("\n\n")[0]
     assert re.search(r"mem_mb=1000,.*runtime=15.*cpus_per_task=1", fig1), fig1
-    # Small simulation jobs share SLURM jobs (groups of up to 8): one allocation, one
-    # queue wait for several chains.
+    # Job groups are off by default: a group asks SLURM for the sum of its jobs' CPUs,
+    # which a small partition never grants (the live test's node has 2).
+    assert "Group job" not in out
+
+
+@pytest.mark.workflow
+def test_slurm_profile_job_groups_as_documented_opt_in():
+    """The profile's commented groups, given on the command line, put simulation jobs
+    in one SLURM job (one allocation, one queue wait for several chains)."""
+    pytest.importorskip("snakemake_executor_plugin_slurm")
+    profile = (ROOT / "profiles" / "slurm" / "config.yaml").read_text()
+    assert "# groups:\n#   - simulate=simulations" in profile
+    out = dry_run(
+        "--workflow-profile", "profiles/slurm", "--cores", "8",
+        "--groups", "simulate=simulations", "ssw_track=simulations",
+        "--group-components", "simulations=2",
+    )  # fmt: skip
     assert "Group job simulations" in out
