@@ -385,3 +385,30 @@ def test_ssw_parity_and_experiment_claims_carry_their_numbers():
     # Fixture: virtual 0.0376 / viscoelastic 0.0417 at N = 25.
     assert experiment["agrees"] == "no" and "0.90" in experiment["ours"]
     assert experiment["why"].startswith("not reproduced by the model; see the mechanism study")
+
+
+def test_the_ssw_tables_are_written_for_reading():
+    """Series named as the article names them, counts as "k of n", value ± error."""
+    from chain.report.article_ssw_tables import (
+        far_field_table,
+        parity_table,
+        resolution_table,
+        separation_table,
+    )
+
+    def label(source, model):
+        return f"{source}, {model}"
+
+    resolved = resolution_table(FINDINGS["ssw_resolved"], label)
+    assert resolved["columns"] == ["Series", "N", "S1 (RSTW)", "S2 (LSTW)"]
+    assert resolved["rows"][0] == ["simulation, elastic", "26", "—", "24 of 24"]
+    far = far_field_table(FINDINGS["ssw_far_field"], label)
+    assert far["rows"][0][1:] == ["N = 120 / 121", "2.9900 ± 0.0010", "0.84800 ± 0.00010",
+                                  "3.5260 ± 0.0010"]  # fmt: skip
+    parity = parity_table([{"source": "experiment", "model": "virtual", "ratio": 1.93,
+                            "ratio_err": 2.046}], label)  # fmt: skip
+    assert parity["rows"] == [["experiment, virtual", "1.9 ± 2.0"]]
+    separation = separation_table(FINDINGS["ssw_separation"], label)
+    assert separation["rows"][0][4:] == ["7", "6.5", "1.012"]
+    assert all(table(None, label) is None for table in
+               (resolution_table, separation_table, parity_table, far_field_table))  # fmt: skip

@@ -25,6 +25,12 @@ import pandas as pd
 from chain.atomic import atomic_output
 from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
 from chain.report.article_figures import CAPTIONS, figure_text
+from chain.report.article_ssw_tables import (
+    far_field_table,
+    parity_table,
+    resolution_table,
+    separation_table,
+)
 from chain.report.article_tables import ablation_tables, c_spread_tables
 from chain.report.claims import (
     NOT_COMPUTED,
@@ -37,7 +43,14 @@ from chain.report.claims import (
     series_models,
 )
 from chain.report.paper import PAPER_ENERGY_DRIFT
-from chain.report.printed import fixed, percent, plus_minus, scientific, table_of
+from chain.report.printed import (
+    fixed,
+    percent,
+    plus_minus,
+    plus_minus_stat_sys,
+    scientific,
+    table_of,
+)
 
 
 def fit_rows(summary: Mapping) -> list[dict]:
@@ -84,12 +97,10 @@ def ssw_slope_rows(summary: Mapping) -> list[dict]:
 
 
 def _slope_text(row: Mapping) -> str:
-    """'0.0343 ± < 0.0001 ± 0.0207' (slope ± stat ± sys), or slope ± stderr."""
+    """'0.034 ± < 0.001 (stat) ± 0.021 (sys)' (slope, N/N), or slope ± stderr."""
     if row.get("slope_sys") is None:
         return plus_minus(row.get("slope"), row.get("slope_stderr"), 4)
-    return (
-        f"{plus_minus(row.get('slope'), row.get('slope_stat'), 4)} ± {fixed(row['slope_sys'], 4)}"
-    )
+    return plus_minus_stat_sys(row.get("slope"), row.get("slope_stat"), row["slope_sys"])
 
 
 def findings(summary: Mapping) -> dict:
@@ -101,20 +112,24 @@ def findings(summary: Mapping) -> dict:
     rows}); an absent or empty key gives None.
     """
     resolved = summary.get("ssw_resolved") or None
+
+    def label(source: str, model: str) -> str:
+        return series_label(summary, source, model)
+
     ablation = summary.get("ablation") or None
     study = summary.get("ssw_mechanisms") or None
     spread = summary.get("c_spread") or None
     return {
-        "ssw_resolved": table_of(resolved),
+        "ssw_resolved": resolution_table(resolved, label),
         "ssw_resolved_count": None
         if resolved is None
         else {
             "resolved": str(sum(bool(r.get("resolved")) for r in resolved)),
             "total": str(len(resolved)),
         },
-        "ssw_separation": table_of(summary.get("ssw_separation")),
-        "ssw_parity_ratio": table_of(summary.get("ssw_parity_ratio")),
-        "ssw_far_field": table_of(summary.get("ssw_far_field")),
+        "ssw_separation": separation_table(summary.get("ssw_separation"), label),
+        "ssw_parity_ratio": parity_table(summary.get("ssw_parity_ratio"), label),
+        "ssw_far_field": far_field_table(summary.get("ssw_far_field"), label),
         "ablation": None
         if ablation is None
         else {

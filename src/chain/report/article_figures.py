@@ -216,7 +216,8 @@ def _paragraph_ssw(summary: Mapping) -> str:
     if slopes:
         return (
             "sets the SSW amplitude against the incident amplitude for every series and "
-            f"chain; where the SSW is resolved, the fitted slopes SSW / F_m are {slopes}."
+            "chain, each point with its error (template misfit and noise) or as an upper "
+            f"limit; the proportional fits of every point give SSW / F_m = {slopes}."
         )
     return (
         "sets the SSW amplitude against the incident amplitude for every series and "
