@@ -4,7 +4,7 @@ import pandas as pd
 from _logging import start
 
 from chain.analysis.rows import flag_unusable
-from chain.analysis.ssw import ssw_fit_table
+from chain.analysis.ssw_fits import ssw_fit_table
 from chain.atomic import write_csv_atomic
 
 log = start(snakemake)

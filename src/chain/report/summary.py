@@ -20,7 +20,7 @@ import pandas as pd
 
 from chain.analysis.rows import flag_counts, is_ok
 from chain.analysis.selection import selection_counts, skipped_shots
-from chain.analysis.ssw import ssw_parity_table, ssw_resolution_table
+from chain.analysis.ssw_fits import ssw_parity_table, ssw_resolution_table
 from chain.analysis.ssw_track import far_field_parity, separation_table
 from chain.atomic import write_text_atomic
 from chain.physics.theory import ballistic_constants
