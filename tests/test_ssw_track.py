@@ -14,7 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chain.analysis.ssw_track import ssw_speed_table, ssw_track_table, track_collision
+from chain.analysis.ssw_speed import ssw_speed_table
+from chain.analysis.ssw_track import ssw_track_table, track_collision
 from chain.physics.materials import STEEL_100C6
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate

@@ -22,7 +22,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from chain.analysis.ssw_track import SPEED_COLUMNS, TRACK_COLUMNS
+from chain.analysis.ssw_speed import SPEED_COLUMNS
+from chain.analysis.ssw_track import TRACK_COLUMNS
 from chain.report.printed import plus_minus
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,10 +1,10 @@
 """The SSW tracks of every chain in one table, and their speeds against Eq. 5
-(chain.analysis.ssw_track.ssw_speed_table)."""
+(chain.analysis.ssw_speed.ssw_speed_table)."""
 
 import pandas as pd
 from _logging import start
 
-from chain.analysis.ssw_track import ssw_speed_table
+from chain.analysis.ssw_speed import ssw_speed_table
 from chain.atomic import write_csv_atomic
 from chain.physics.materials import get_material
 from chain.physics.theory import nesterenko_speed_from_force

@@ -16,7 +16,8 @@ from pathlib import Path
 
 from chain.analysis.delays import DELAY_FIT_COLUMNS
 from chain.analysis.ssw_fits import SSW_FIT_COLUMNS
-from chain.analysis.ssw_track import SPEED_COLUMNS, TRACK_COLUMNS
+from chain.analysis.ssw_speed import SPEED_COLUMNS
+from chain.analysis.ssw_track import TRACK_COLUMNS
 
 #: Files of the results contract (design.md), relative to results/<run_name>/.
 CONTRACT_FIGURES = (

@@ -21,7 +21,7 @@ import pandas as pd
 from chain.analysis.rows import flag_counts, is_ok
 from chain.analysis.selection import selection_counts, skipped_shots
 from chain.analysis.ssw_fits import ssw_parity_table, ssw_resolution_table
-from chain.analysis.ssw_track import far_field_parity, separation_table
+from chain.analysis.ssw_speed import far_field_parity, separation_table
 from chain.atomic import write_text_atomic
 from chain.physics.theory import ballistic_constants
 from chain.report.paper import PAPER
@@ -191,11 +191,11 @@ def ssw_summary(
         (:func:`chain.analysis.ssw.ssw_resolution_table`); ``ssw_separation``: per
         model, N and wave, ``first_separated_contact`` (None if never),
         ``distance_beads`` from the collision point, ``speed_ratio`` to Eq. 5
-        (:func:`chain.analysis.ssw_track.separation_table`); ``ssw_parity_ratio``: per
+        (:func:`chain.analysis.ssw_speed.separation_table`); ``ssw_parity_ratio``: per
         source and model, the SSW slope of N = 26 over N = 25 with ``ratio_err`` (None
         without both); ``ssw_far_field``: per source and model, SSW / F_m far from the
         collision point in the longest even and odd chain, with errors, and their ratio
-        (:func:`chain.analysis.ssw_track.far_field_parity`).
+        (:func:`chain.analysis.ssw_speed.far_field_parity`).
     """
     separation = [] if ssw_speed is None else _records(separation_table(ssw_speed))
     for row in separation:
