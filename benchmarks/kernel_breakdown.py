@@ -71,8 +71,13 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
         ("EVENT_AFTERMATH = 3", f"EVENT_AFTERMATH = {aftermath}"),
         ("cache=True", "cache=False"),
     ]
-    if not refine:  # detect events (same work) but keep the coarse step
-        edits.append(("        if not (varied or end[2] != slope[2]):\n", "        if True:\n"))
+    if not refine:  # detect events (same work, refined code present) but keep the coarse step
+        edits.append(
+            (
+                "            if event:  # redone in substeps below\n",
+                "            if event and dt < 0.0:  # never true; numba cannot know it\n",
+            )
+        )
     for old, new in edits:
         assert old in source, f"kernels.py changed: {old!r} not found"
         source = source.replace(old, new)
