@@ -162,3 +162,55 @@ def test_a_sweep_in_one_pool_gives_the_bits_of_separate_calls(threads):
                 )
             ]
         )
+
+
+#: Long chains whose middle the lean kernel skips until the waves come near it, and
+#: whether they come near it within the test's 4 ms (track friction slows them).
+LONG_MODELS = {
+    "elastic": (lambda: uniform_chain(420), True),
+    "sensors+walls+damping": (
+        lambda: uniform_chain(
+            400, eta=0.58e-6, sensor_beads=[150, 200, 330], left_wall=True, right_wall=True
+        ),
+        True,
+    ),
+    "strikers+drag": (
+        lambda: uniform_chain(
+            380, eta=0.58e-6, sensor_beads=[190], striker_radius=4e-3, drag_rate=30.0
+        ),
+        False,
+    ),
+}
+
+
+@pytest.mark.parametrize("name", LONG_MODELS)
+def test_skipping_beads_at_rest_gives_the_reference_bits(name, monkeypatch):
+    """A long chain's middle, at rest, is skipped (chain.physics.at_rest) and the
+    skipped part shrinks as the waves approach: same bits as the reference kernel,
+    which integrates every bead at every step; a launch from one end and one from
+    both ends; records chosen in and out of the skipped part."""
+    from chain.physics import at_rest
+
+    parts = []
+    real = at_rest._integrate_part
+
+    def counted(*args):
+        parts.append(args[0].shape[0])
+        return real(*args)
+
+    monkeypatch.setattr(at_rest, "_integrate_part", counted)
+    factory, shrinks = LONG_MODELS[name]
+    model = factory()
+    velocity = launch_velocities(model, [1.0, 0.5], [1.0, 0.0])
+    dt = default_time_step(model, 1.0)
+    links = [0, 5, 140, 200, 260, model.n_particles - 2]
+    particles = [0, 100, 210, model.n_particles - 1]
+    kwargs = dict(record_every=25, links=links, particles=particles)
+    lean = integrate(model, velocity, 4e-3, dt, **kwargs)
+    reference = integrate(model, velocity, 4e-3, dt, kernel="reference", **kwargs)
+    for field in FIELDS:
+        np.testing.assert_array_equal(getattr(lean, field), getattr(reference, field), field)
+    assert min(parts) <= model.n_particles - at_rest.MIN_SKIPPED  # the middle was skipped
+    # and, where the waves came near it, the skipped part shrank: a launch ran in parts
+    assert (len(parts) > 2) == shrinks
+    assert np.all(lean.refined_steps > 0)

@@ -21,7 +21,8 @@ import numpy as np
 
 from chain.errors import ParameterError, require_int, require_positive
 from chain.physics import reference_kernel
-from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_one
+from chain.physics.at_rest import integrate_launch
+from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
 from chain.physics.model import HERTZ, SPRING, ChainModel
 
 #: Default bound on the relative energy drift before a run is declared broken.
@@ -343,7 +344,7 @@ def _lean_launches(model: ChainModel, run, n_samples: int, links, particles):
 
     def launch(b: int) -> None:
         one = tuple(out[b] for out in outputs)
-        result = _integrate_one(
+        result = integrate_launch(
             displacement[b], velocity[b], params, dt, n_steps, record_every, links, particles, one
         )
         status[b], fail_step[b], refined[b] = result

@@ -56,6 +56,12 @@ _NOT_FINITE = 1
 EVENT_SUBSTEPS = 16
 EVENT_AFTERMATH = 3
 
+#: Beads at rest kept between the beads that move and the beads a run skips
+#: (:mod:`chain.physics.at_rest`): a refined step spreads a disturbance by at most
+#: 4 EVENT_SUBSTEPS beads (one per right-hand side), so the skipped beads never move
+#: within a step.
+QUIET_MARGIN = 4 * EVENT_SUBSTEPS + 4
+
 
 @numba.njit(cache=True, inline="always")
 def _copy_into(target, source):
@@ -299,19 +305,23 @@ def _rk4(u, v, acc0, slope0, dt, buffers, force, im, k, c, keys, springs, walls,
 @numba.njit(cache=True)
 def _record(u, v, dissipated, model, links, particles, sample, outputs):
     """Writes sample ``sample``; returns False when the state is not finite.
-    ``model`` = (masses, k, c, keys, walls, kind)."""
+    ``model`` = (masses, k, c, keys, walls, kind); ``links`` = (link indices, their
+    columns in the record), ``particles`` likewise."""
     out_link, out_wall, out_velocity, out_energy, out_momentum = outputs
     masses, k, c, keys, walls, kind = model
     left, right, _, _ = _wall_terms(u, v, keys, walls)
+    links, link_columns = links
+    particles, particle_columns = particles
     for i in range(links.shape[0]):
         j = links[i]
         delta = u[j] - u[j + 1]
         if kind[j] == 1:
-            out_link[sample, i] = k[j] * delta
+            out_link[sample, link_columns[i]] = k[j] * delta
         else:
-            out_link[sample, i] = _hertz_force(k[j], c[j], delta, v[j] - v[j + 1])[1]
+            force = _hertz_force(k[j], c[j], delta, v[j] - v[j + 1])[1]
+            out_link[sample, link_columns[i]] = force
     for i in range(particles.shape[0]):
-        out_velocity[sample, i] = v[particles[i]]
+        out_velocity[sample, particle_columns[i]] = v[particles[i]]
     kinetic = 0.0
     momentum = 0.0
     finite = True
@@ -417,8 +427,43 @@ def _refined_step(x_u, x_v, x_acc, y_u, y_v, work, slope, dt, im, k, c, keys, sp
 
 @numba.njit(cache=True, nogil=True)
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
-    """RK4 for one launch; ``u`` and ``v`` end as the final state. Returns the status,
-    the step at which it was set, and the number of steps refined at contact events."""
+    """RK4 for one launch of the whole chain; ``u`` and ``v`` end as the final state.
+    Returns the status, the step at which it was set, and the number of steps refined
+    at contact events."""
+    links = (links, np.arange(links.shape[0]))
+    particles = (particles, np.arange(particles.shape[0]))
+    status, step, refined, _, _, _ = _integrate_part(
+        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1
+    )
+    return status, step, refined
+
+
+@numba.njit(cache=True, inline="always")
+def _reached(u, v, gap, spread):
+    """Whether a step that spread a disturbance by ``spread`` beads or fewer brought it
+    into the QUIET_MARGIN beads at rest on either side of bead ``gap`` (see
+    :mod:`chain.physics.at_rest`): only the beads it could have reached are looked at."""
+    n = u.shape[0]
+    for p in range(max(gap - QUIET_MARGIN, 0), max(gap - QUIET_MARGIN + spread, 0)):
+        if u[p] != 0.0 or v[p] != 0.0:
+            return True
+    for p in range(min(gap + QUIET_MARGIN - spread, n), min(gap + QUIET_MARGIN, n)):
+        if u[p] != 0.0 or v[p] != 0.0:
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
+def _integrate_part(
+    u, v, params, dt, step, n_steps, record_every, links, particles, outputs,
+    refine, refined, dissipated, gap,
+):  # fmt: skip
+    """RK4 for one launch from step ``step`` (sample 0 is recorded at step 0) to
+    ``n_steps``, or until a disturbance comes within QUIET_MARGIN beads of bead ``gap``
+    (-1: never), whose left neighbour stands for skipped beads at rest; ``u`` and
+    ``v`` end as the state reached. ``links`` and ``particles``: (indices, record
+    columns). Returns (status, step reached, refined steps, refine, dissipated energy
+    J, whether the margin was reached)."""
     im, masses, k, damping, keys, springs, walls, drag, kind, c = params
     # Unpacked once: a tuple holding None gives wrong elements inside some callees.
     recorded = (masses, k, damping, keys, walls, kind)
@@ -426,21 +471,21 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     # Five RK4 buffers, the spare accelerations of the substeps, the link forces.
     work = (
         np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
-        np.empty(n - 1),
+        np.empty(max(n - 1, 1)),
     )  # fmt: skip
     x_u, x_v, x_acc = np.empty(n), np.empty(n), np.empty(n)
     y_u, y_v, y_acc = np.empty(n), np.empty(n), np.empty(n)
     _copy_into(x_u, u)
     _copy_into(x_v, v)
     slope = _slopes(x_u, x_v, x_acc, work[6], im, k, c, keys, springs, walls, drag)
-    dissipated = 0.0
-    _record(x_u, x_v, dissipated, recorded, links, particles, 0, outputs)
-    refine = refined = step = 0
-    in_y = False  # the state is in (y_u, y_v, y_acc), else in (x_u, x_v, x_acc)
+    if step == 0:
+        _record(x_u, x_v, dissipated, recorded, links, particles, 0, outputs)
     status = _OK
-    while step < n_steps and status == _OK:
+    in_y = False  # the state is in (y_u, y_v, y_acc), else in (x_u, x_v, x_acc)
+    reached = False
+    while step < n_steps and status == _OK and not reached:
         target = min(n_steps, (step // record_every + 1) * record_every)
-        while refine == 0 and step < target:
+        while refine == 0 and step < target and not reached:
             if in_y:
                 increment, end, event = _plain_step(
                     y_u, y_v, y_acc, x_u, x_v, x_acc, work, slope, dt,
@@ -458,7 +503,9 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
                 in_y = not in_y
                 dissipated += increment
                 slope = end
-        if refine > 0 and step < target:
+                if gap >= 0:
+                    reached = _reached(y_u, y_v, gap, 4) if in_y else _reached(x_u, x_v, gap, 4)
+        if refine > 0 and step < target and not reached:
             if in_y:
                 increment, slope, event = _refined_step(
                     y_u, y_v, y_acc, x_u, x_v, work, slope, dt,
@@ -473,7 +520,12 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
             refined += 1
             step += 1
             dissipated += increment
-        if step == target and step % record_every == 0:
+            if gap >= 0:
+                spread = 4 * EVENT_SUBSTEPS
+                reached = (
+                    _reached(y_u, y_v, gap, spread) if in_y else _reached(x_u, x_v, gap, spread)
+                )
+        if step % record_every == 0 and step == target:
             sample = step // record_every
             if in_y:
                 finite = _record(y_u, y_v, dissipated, recorded, links, particles, sample, outputs)
@@ -488,4 +540,4 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
         status = _NOT_FINITE
     _copy_into(u, x_u)
     _copy_into(v, x_v)
-    return status, step, refined
+    return status, step, refined, refine, dissipated, reached
