@@ -34,14 +34,17 @@ measurement of the target", never as met. Not a test: it asserts nothing, it rep
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import math
 import os
 import platform
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -50,8 +53,9 @@ from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, load_c, machine
 from measure import c_run as c_run_equal
 from scipy.integrate import solve_ivp
 
+from chain.physics import kernels
 from chain.physics.integrator import _lean_params, _outputs, integrate
-from chain.physics.kernels import _integrate_one
+from chain.physics.kernels import EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_one
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
 from chain.physics.model import launch_velocities, uniform_chain
 from chain.physics.simulation import default_time_step, simulate
@@ -116,10 +120,40 @@ def dop853(rtol: float, velocity, samples):
     return (kappa * overlap**1.5).T, drift
 
 
+def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
+    """A copy of chain.physics.kernels with another refinement scheme, as a module."""
+    source = Path(kernels.__file__).read_text()
+    edits = [
+        ("EVENT_SUBSTEPS = 16", f"EVENT_SUBSTEPS = {substeps}"),
+        ("EVENT_AFTERMATH = 3", f"EVENT_AFTERMATH = {aftermath}"),
+        ("cache=True", "cache=False"),
+    ]
+    if not refine:  # detect events (same work, refined code present) but keep the coarse step
+        edits.append(
+            (
+                "            if event:  # redone in substeps below\n",
+                "            if event and dt < 0.0:  # never true; numba cannot know it\n",
+            )
+        )
+    for old, new in edits:
+        assert old in source, f"kernels.py changed: {old!r} not found"
+        source = source.replace(old, new)
+    name = f"kernel_{substeps}_{aftermath}_{int(refine)}"
+    path = folder / f"{name}.py"
+    path.write_text(source)
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
 def kernel_against_c(args, c_function) -> dict:
     """Section 1: chain.simulate (defaults), the lean and the reference kernel against C
     at the default step; returns {label: (simulate / C, integrate / C)}."""
     results = {}
+    folder = tempfile.mkdtemp()
+    unrefined = patched_kernel(Path(folder), EVENT_SUBSTEPS, EVENT_AFTERMATH, False)
     for eta in (0.0, ETA):
         model = uniform_chain(N_BEADS, eta=eta)
         velocity = launch_velocities(model, SPEED, SPEED)
@@ -134,6 +168,10 @@ def kernel_against_c(args, c_function) -> dict:
             "simulate": lambda model=model: simulate(model, SPEED, SPEED, duration=DURATION),
             "integrate": lambda: run("lean"),
             "reference": lambda: run("reference"),
+            # The bound, measured: the kernel alone, and with the refinement of contact
+            # events switched off (detection kept).
+            "kernel": kernel_alone(kernels, model, velocity[0], dt, n_steps, every),
+            "unrefined": kernel_alone(unrefined, model, velocity[0], dt, n_steps, every),
         }
         if c_function is not None:
             contenders["C"] = lambda v=velocity[0], e=eta, d=dt, s=n_steps, r=every: c_run(
@@ -164,7 +202,37 @@ def kernel_against_c(args, c_function) -> dict:
                 f"integrate / C = {results[label][1]:.2f}; "
                 f"reference / C = {best['reference'] / best['C']:.2f}"
             )
+            print_bound(best)
+    shutil.rmtree(folder, ignore_errors=True)
     return results
+
+
+def kernel_alone(module, model, velocity, dt: float, n_steps: int, every: int):
+    """A launch through ``module``'s kernel, called directly (outputs allocated)."""
+    params = _lean_params(model)
+    n = model.n_particles
+    links, particles = np.arange(n - 1), np.arange(n)
+
+    def run():
+        outputs = tuple(o[0] for o in _outputs(1, n_steps // every + 1, n - 1, n))
+        u, v = np.zeros(n), velocity.copy()
+        module._integrate_one(u, v, params, dt, n_steps, every, links, particles, outputs)
+
+    return run
+
+
+def print_bound(best: dict) -> None:
+    """Where simulate's time goes, as multiples of C, from the same run's figures."""
+    c = best["C"]
+    parts = {
+        "plain RK4 steps and contact-event detection": best["unrefined"],
+        "refinement of the steps with contact events": best["kernel"] - best["unrefined"],
+        "integrate(): checks, allocation, energy check": best["integrate"] - best["kernel"],
+        "simulate(): arguments, default step, bead view": best["simulate"] - best["integrate"],
+    }
+    print("  where simulate's time goes (x C; the differences carry the noise of two runs):")
+    for name, seconds in parts.items():
+        print(f"    {name:48s} {seconds / c:5.2f}")
 
 
 def scan_rtol(velocity, samples, fine, our_drift, our_error):

@@ -32,14 +32,12 @@ A diagnostic, not a test: it asserts only that the patched lines still exist.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import math
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
-from bench_integrator import c_run, dop853
+from bench_integrator import c_run, dop853, patched_kernel
 from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, load_c
 
 from chain.physics import kernels
@@ -61,34 +59,6 @@ SCHEMES = (
     ("64 substeps, aftermath 12", 64, 12, True),
 )
 CONVERGED = "64 substeps, aftermath 12"
-
-
-def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
-    """A copy of chain.physics.kernels with another refinement scheme, as a module."""
-    source = Path(kernels.__file__).read_text()
-    edits = [
-        ("EVENT_SUBSTEPS = 16", f"EVENT_SUBSTEPS = {substeps}"),
-        ("EVENT_AFTERMATH = 3", f"EVENT_AFTERMATH = {aftermath}"),
-        ("cache=True", "cache=False"),
-    ]
-    if not refine:  # detect events (same work, refined code present) but keep the coarse step
-        edits.append(
-            (
-                "            if event:  # redone in substeps below\n",
-                "            if event and dt < 0.0:  # never true; numba cannot know it\n",
-            )
-        )
-    for old, new in edits:
-        assert old in source, f"kernels.py changed: {old!r} not found"
-        source = source.replace(old, new)
-    name = f"kernel_{substeps}_{aftermath}_{int(refine)}"
-    path = folder / f"{name}.py"
-    path.write_text(source)
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
 
 
 def main() -> None:

@@ -313,13 +313,14 @@ def _lean_params(model: ChainModel) -> tuple:
     n_links = model.n_particles - 1
     # A copy: the kernels take writable arrays (a read-only one is another signature).
     keys = _contact_keys(n_links).copy()
-    springs = np.r_[np.flatnonzero(kind == SPRING), n_links].astype(np.int64)
+    springs = np.append(np.flatnonzero(kind == SPRING), n_links).astype(np.int64)
     walls = np.stack([model.wall_stiffness, 1.5 * model.wall_eta * model.wall_stiffness], axis=1)
     drag = np.stack([model.drag_rate, model.masses * model.drag_rate], axis=1)
     # None when absent, so that numba compiles a kernel without them.
-    walls = np.ascontiguousarray(walls) if np.any(model.wall_stiffness > 0) else None
-    drag = np.ascontiguousarray(drag) if np.any(model.drag_rate > 0) else None
-    damped = damping if np.any(damping[kind == HERTZ] > 0) else None
+    # (array.any(): numpy's np.any wrapper costs more than the test on a short chain)
+    walls = np.ascontiguousarray(walls) if (model.wall_stiffness > 0).any() else None
+    drag = np.ascontiguousarray(drag) if (model.drag_rate > 0).any() else None
+    damped = damping if (damping[kind == HERTZ] > 0).any() else None
     return (
         1.0 / model.masses,
         np.ascontiguousarray(model.masses, dtype=float),

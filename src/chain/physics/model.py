@@ -395,9 +395,9 @@ def launch_velocities(model: ChainModel, v_left, v_right=0.0) -> np.ndarray:
         np.atleast_1d(np.asarray(v_left, dtype=float)),
         np.atleast_1d(np.asarray(v_right, dtype=float)),
     )
-    if np.any(~np.isfinite(left)) or np.any(left < 0):
+    if not np.isfinite(left).all() or (left < 0).any():
         raise ParameterError(f"v_left must be finite and >= 0 m/s, got {v_left!r}")
-    if np.any(~np.isfinite(right)) or np.any(right < 0):
+    if not np.isfinite(right).all() or (right < 0).any():
         raise ParameterError(f"v_right must be finite and >= 0 m/s, got {v_right!r}")
     velocities = np.zeros((len(left), model.n_particles))
     if model.left_striker >= 0:

@@ -73,7 +73,7 @@ def default_time_step(model: ChainModel, max_launch_speed: float) -> float:
     # Linear in N: the Hertz time is computed once per distinct (m_a, m_b, kappa).
     triples = np.stack([moving[hertz], moving[hertz + 1], model.link_stiffness[hertz]], axis=1)
     # A uniform chain has one triple: np.unique's sort is most of a short run's set-up.
-    triples = triples[:1] if np.all(triples == triples[:1]) else np.unique(triples, axis=0)
+    triples = triples[:1] if (triples == triples[:1]).all() else np.unique(triples, axis=0)
     steps = [math.inf]
     for m_a, m_b, kappa in triples:
         contact = hertz_contact_time(float(m_a), float(m_b), np.float64(kappa), relative)
