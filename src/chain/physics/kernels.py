@@ -250,6 +250,51 @@ def _reached(u, v, gap, spread):
     return False
 
 
+@numba.njit(cache=True, inline="always")
+def _reached_in(in_y, x_u, x_v, y_u, y_v, gap, spread):
+    """_reached on the state (in y or in x); False when there is no ``gap`` (-1)."""
+    if gap < 0:
+        return False
+    return _reached(y_u, y_v, gap, spread) if in_y else _reached(x_u, x_v, gap, spread)
+
+
+@numba.njit(cache=True, inline="always")
+def _refined_state(
+    in_y, x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt, im, k, c, keys, springs, walls, drag
+):
+    """_refined_step from the state (in y or in x), which stays where it is."""
+    if in_y:
+        return _refined_step(
+            y_u, y_v, y_acc, x_u, x_v, work, slope, dt, im, k, c, keys, springs, walls, drag
+        )
+    return _refined_step(
+        x_u, x_v, x_acc, y_u, y_v, work, slope, dt, im, k, c, keys, springs, walls, drag
+    )
+
+
+@numba.njit(cache=True)
+def _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status):
+    """The state reached (in y or in x) into (u, v); returns the status, set to
+    _NOT_FINITE if it was _OK and the state is not finite."""
+    if in_y:
+        _copy_into(x_u, y_u)
+        _copy_into(x_v, y_v)
+    if status == _OK and not (_all_finite(x_u) and _all_finite(x_v)):
+        status = _NOT_FINITE
+    _copy_into(u, x_u)
+    _copy_into(v, x_v)
+    return status
+
+
+@numba.njit(cache=True, inline="always")
+def _work_buffers(n):
+    """Five RK4 buffers, the spare accelerations of the substeps, the link forces."""
+    return (
+        np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
+        np.empty(max(n - 1, 1)),
+    )  # fmt: skip
+
+
 @numba.njit(cache=True, nogil=True)
 def _integrate_part(
     u, v, params, dt, step, n_steps, record_every, links, particles, outputs,
@@ -265,15 +310,9 @@ def _integrate_part(
     # Unpacked once: a tuple holding None gives wrong elements inside some callees.
     recorded = (masses, k, damping, keys, walls, kind)
     n = u.shape[0]
-    # Five RK4 buffers, the spare accelerations of the substeps, the link forces.
-    work = (
-        np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
-        np.empty(max(n - 1, 1)),
-    )  # fmt: skip
-    x_u, x_v, x_acc = np.empty(n), np.empty(n), np.empty(n)
+    work = _work_buffers(n)
+    x_u, x_v, x_acc = u.copy(), v.copy(), np.empty(n)
     y_u, y_v, y_acc = np.empty(n), np.empty(n), np.empty(n)
-    _copy_into(x_u, u)
-    _copy_into(x_v, v)
     slope = _slopes(x_u, x_v, x_acc, work[6], im, k, c, keys, springs, walls, drag)
     if step == 0:
         _record(x_u, x_v, dissipated, recorded, links, particles, 0, outputs)
@@ -300,41 +339,26 @@ def _integrate_part(
                 in_y = not in_y
                 dissipated += increment
                 slope = end
-                if gap >= 0:
+                if gap >= 0:  # (tested here: inside the helper it cost 5 %)
                     reached = _reached(y_u, y_v, gap, 4) if in_y else _reached(x_u, x_v, gap, 4)
         if refine > 0 and step < target and not reached:
-            if in_y:
-                increment, slope, event = _refined_step(
-                    y_u, y_v, y_acc, x_u, x_v, work, slope, dt,
-                    im, k, c, keys, springs, walls, drag,
-                )  # fmt: skip
-            else:
-                increment, slope, event = _refined_step(
-                    x_u, x_v, x_acc, y_u, y_v, work, slope, dt,
-                    im, k, c, keys, springs, walls, drag,
-                )  # fmt: skip
+            increment, slope, event = _refined_state(
+                in_y, x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt,
+                im, k, c, keys, springs, walls, drag,
+            )  # fmt: skip
             refine = EVENT_AFTERMATH if event else refine - 1
             refined += 1
             step += 1
             dissipated += increment
-            if gap >= 0:
-                spread = 4 * EVENT_SUBSTEPS
-                reached = (
-                    _reached(y_u, y_v, gap, spread) if in_y else _reached(x_u, x_v, gap, spread)
-                )
+            reached = _reached_in(in_y, x_u, x_v, y_u, y_v, gap, 4 * EVENT_SUBSTEPS)
         if step % record_every == 0 and step == target:
             sample = step // record_every
+            # Written out: as a helper taking the state's place, the kernel ran 4 % slower.
             if in_y:
                 finite = _record(y_u, y_v, dissipated, recorded, links, particles, sample, outputs)
             else:
                 finite = _record(x_u, x_v, dissipated, recorded, links, particles, sample, outputs)
             if not finite:
                 status = _NOT_FINITE
-    if in_y:
-        _copy_into(x_u, y_u)
-        _copy_into(x_v, y_v)
-    if status == _OK and not (_all_finite(x_u) and _all_finite(x_v)):
-        status = _NOT_FINITE
-    _copy_into(u, x_u)
-    _copy_into(v, x_v)
+    status = _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status)
     return status, step, refined, refine, dissipated, reached
