@@ -1,39 +1,31 @@
-"""Time a full rebuild of the pipeline (the paper run by default) and say where the time
-goes.
+"""What a user waits for: the paper run, a forced rebuild, three what-ifs and the tests
+(issue 33), each with its job count, against its target.
 
-The run happens in a temporary copy of the checkout (the files git tracks, plus the
-numba cache of ``src/chain`` unless ``--fresh``), whose ``src`` the jobs import: it
-never touches ``results/paper/`` or the checkout's sources, and always rebuilds
-everything::
+Every round works in a fresh copy of the checkout (the files git tracks, no numba cache,
+no results, no reuse store: a fresh clone), whose ``src`` the jobs import, and runs in
+order::
 
-    python benchmarks/bench_pipeline.py                    # paper run, 2 cores
-    python benchmarks/bench_pipeline.py --cores 2 --configfile whatif/parity.yaml
-    python benchmarks/bench_pipeline.py --json timings.json --keep /tmp/bench
-    python benchmarks/bench_pipeline.py --fresh     # also: numba cache empty
+    paper       snakemake --cores 2                       numba's cache empty
+    forced      snakemake --cores 2 --forceall            warm (numba's cache, the store)
+    brass       snakemake --cores 2 --configfile whatif/brass.yaml     after the paper run
+    analysis    an overlay: run_name bench_analysis, analysis: {main_estimator: peak}
+    figure      an overlay: run_name bench_figure, figures: {representative_force_N: 100}
 
-It prints the wall time of the whole ``snakemake`` call, the time Snakemake needs to
-parse the workflow and build the DAG (a dry run), and per rule the number of jobs and
-their wall and CPU times from the ``benchmark:`` files. For the simulation jobs it
-splits the wall time into start-up (Python, imports, numba cache), integration and
-writing the trace CSV, from the timestamps of the job logs.
+``--repeat`` rounds are interleaved (each round runs every scenario once, so that load
+hits all of them alike) and the best of each is printed, with the load average before
+and after, and a verdict that is never "met" when the machine was loaded. Then the
+README's test command runs once in the last copy (``--no-tests`` skips it)::
 
-Then it **restyles one figure**: a line is added to the copy's
-``src/chain/report/fig4_delay_vs_force.py`` (Snakemake reruns on content, not on a
-newer modification time alone) and the ``snakemake`` call that follows is timed, with
-the jobs it reran. ``--fresh`` first rebuilds with the numba cache empty, as a fresh
-clone does, then rebuilds again with the cache it filled.
+    python benchmarks/bench_pipeline.py                  # 3 rounds and the tests
+    python benchmarks/bench_pipeline.py --repeat 1 --no-tests --keep /tmp/bench
 
-``--imports`` finally rebuilds once more on one core with ``PYTHONPROFILEIMPORTTIME``
-(``python -X importtime`` for every job) and prints, per rule, the seconds its jobs
-spent importing modules, and how much of it went to the heavy packages (cumulative:
-a package's figure includes what it was first to load, so scipy.signal includes
-scipy.stats). Import timing slows imports a little; read the shares.
+For the paper run it also prints, per rule, the jobs and their summed wall and CPU time
+(the ``benchmark:`` files): what bounds the figure.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import re
 import shutil
@@ -41,244 +33,150 @@ import subprocess
 import sys
 import tempfile
 import time
-from datetime import datetime
 from pathlib import Path
 
 import pandas as pd
-import yaml
+
+sys.path.insert(0, str(Path(__file__).parent))
+from measure import Conditions
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: Targets of issue 14 on a 2-core machine, s: full rebuild with a warm numba cache, from
-#: a fresh clone (numba cache empty), restyling one figure, the slowest figure job.
-TARGET_S = {"rebuild": 25.0, "fresh": 60.0, "restyle": 3.0, "figure_job": 3.0}
+#: (name, snakemake arguments, overlay written into the copy or None, target s, stretch s)
+SCENARIOS = (
+    ("paper", [], None, 45.0, 30.0),
+    ("forced", ["--forceall"], None, None, None),
+    ("brass", ["--configfile", "whatif/brass.yaml"], None, 40.0, None),
+    ("analysis", ["--configfile", "bench_analysis.yaml"],
+     "run_name: bench_analysis\nanalysis: {main_estimator: peak}\n", 15.0, None),
+    ("figure", ["--configfile", "bench_figure.yaml"],
+     "run_name: bench_figure\nfigures: {representative_force_N: 100}\n", 10.0, None),
+)  # fmt: skip
+#: The test suite and .ci/run, s.
+TESTS_TARGET_S = 240.0
 
-#: The figure module the restyle step "edits", and the rule that draws it.
-RESTYLED = ("src/chain/report/fig4_delay_vs_force.py", "fig4_delay_vs_force")
-
-
-def snakemake(args, work: Path) -> tuple[float, subprocess.CompletedProcess]:
-    """Run snakemake in the copy ``work``, its jobs importing the copy's library."""
-    command = [sys.executable, "-m", "snakemake", *args]
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join([str(work / "src"), os.environ.get("PYTHONPATH", "")]),
-    }
-    start = time.perf_counter()
-    result = subprocess.run(command, cwd=work, capture_output=True, text=True, env=env)
-    elapsed = time.perf_counter() - start
-    if result.returncode != 0:
-        sys.stderr.write(result.stdout[-4000:] + result.stderr[-4000:])
-        raise SystemExit(f"snakemake failed: {' '.join(command)}")
-    return elapsed, result
+_JOB_LINE = re.compile(r"^\s*(?:local)?rule (\w+):", re.MULTILINE)
 
 
-def run_name(configfiles: list[Path]) -> str:
-    name = yaml.safe_load((ROOT / "config.yaml").read_text())["run_name"]
-    for path in configfiles:
-        name = (yaml.safe_load(path.read_text()) or {}).get("run_name", name)
-    return name
-
-
-def benchmark_table(out: Path) -> pd.DataFrame:
-    """One row per job with a benchmark file: rule, job, wall s, CPU s, max RSS MB."""
-    rows = []
-    for path in sorted((out / "benchmarks").rglob("*.tsv")):
-        table = pd.read_csv(path, sep="\t")
-        relative = path.relative_to(out / "benchmarks")
-        group = relative.parts[0] if len(relative.parts) > 1 else relative.stem
-        rule = {"tables": relative.stem, "figures": relative.stem}.get(group, group)
-        rows.append(
-            {
-                "rule": rule,
-                "job": str(relative.with_suffix("")),
-                "wall_s": float(table["s"].iloc[-1]),
-                "cpu_s": float(table["cpu_time"].iloc[-1]),
-                "max_rss_MB": float(table["max_rss"].iloc[-1]),
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-_STAMP = re.compile(r"^(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d,\d{3}) INFO [^:]+: (.*)$")
-
-
-def simulate_phases(out: Path, jobs: pd.DataFrame) -> pd.DataFrame:
-    """Start-up / integration / CSV writing of each simulation job, s (from its log)."""
-    rows = []
-    for path in sorted((out / "logs" / "simulate").glob("*.log")):
-        stamps = []
-        for line in path.read_text().splitlines():
-            match = _STAMP.match(line)
-            if match:
-                when = datetime.strptime(match[1], "%Y-%m-%d %H:%M:%S,%f").timestamp()
-                stamps.append((when, match[2]))
-        marks = {text.split(" ")[0]: when for when, text in stamps}
-        if not {"inputs:", "dt", "done"} <= set(marks):
-            continue
-        wall = jobs.loc[jobs["job"] == f"simulate/{path.stem}", "wall_s"]
-        integrate = marks["dt"] - marks["inputs:"]
-        write = marks["done"] - marks["dt"]
-        total = float(wall.iloc[0]) if len(wall) else float("nan")
-        rows.append(
-            {
-                "job": path.stem,
-                "wall_s": total,
-                "startup_s": total - integrate - write,
-                "integrate_s": integrate,
-                "write_csv_s": write,
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def copy_checkout(work: Path, numba_cache: bool) -> None:
-    """The files git tracks into ``work`` (and the numba cache files of the package,
-    with their modification times, which numba's index checks)."""
+def copy_checkout(work: Path) -> None:
+    """The files git tracks (as they are in the work tree) into ``work``."""
     tracked = subprocess.run(
         ["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, text=True, check=True
     ).stdout.split("\0")
-    cached = ROOT.glob("src/chain/**/__pycache__/*.nb[ic]") if numba_cache else []
-    for path in [ROOT / name for name in tracked if name] + list(cached):
+    for name in filter(None, tracked):
+        path = ROOT / name
         if path.is_file():
-            target = work / path.relative_to(ROOT)
+            target = work / name
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(path, target)
 
 
-def restyle(work: Path, cores: int, extra: list[str]) -> tuple[float, list[str]]:
-    """Edit the restyled figure's module in the copy and rerun. Returns the wall time
-    of the run, s, and the rules it ran."""
-    with open(work / RESTYLED[0], "a") as module:
-        module.write("# restyled by bench_pipeline.py\n")
-    elapsed, result = snakemake(["--cores", str(cores), *extra], work)
-    ran = re.findall(r"^(?:local)?rule (\w+):", result.stdout + result.stderr, re.MULTILINE)
-    return elapsed, ran
+def environment(work: Path) -> dict:
+    """The environment of a run in the copy: its jobs import the copy's library."""
+    path = os.pathsep.join([str(work / "src"), os.environ.get("PYTHONPATH", "")])
+    return {**os.environ, "PYTHONPATH": path}
 
 
-#: Packages whose import cost --imports shows per rule.
-HEAVY_IMPORTS = ("snakemake", "pandas", "numba", "matplotlib.figure", "scipy.signal",
-                 "scipy.stats", "scipy.optimize", "scipy.interpolate")  # fmt: skip
-
-_RULE_LINE = re.compile(r"^\s*(?:local)?rule (\w+):")
-_IMPORT_LINE = re.compile(r"^import time:\s+\d+ \|\s+(\d+) \|( *)(\S+)$")
-
-
-def import_table(work: Path, extra: list[str]) -> pd.DataFrame:
-    """Per rule: jobs, seconds of imports (top-level, summed), seconds per heavy package.
-
-    A forced rebuild on one core, so that each job's import report follows the
-    ``rule <name>:`` line Snakemake writes before it."""
-    env_name = "PYTHONPROFILEIMPORTTIME"
-    os.environ[env_name] = "1"
-    try:
-        _, done = snakemake(["--cores", "1", "--forceall", *extra], work)
-    finally:
-        del os.environ[env_name]
-    rows: dict[str, dict] = {}
-    rule = "(snakemake itself)"
-    for line in done.stderr.splitlines():
-        header = _RULE_LINE.match(line)
-        if header:
-            rule = header.group(1)
-            row = rows.setdefault(rule, {"rule": rule, "jobs": 0, "imports_s": 0.0})
-            row["jobs"] += 1
-            continue
-        timing = _IMPORT_LINE.match(line)
-        if not timing:
-            continue
-        seconds, indent, module = int(timing.group(1)) / 1e6, timing.group(2), timing.group(3)
-        row = rows.setdefault(rule, {"rule": rule, "jobs": 0, "imports_s": 0.0})
-        if indent == " ":  # top level: "| name" (one space after the bar)
-            row["imports_s"] += seconds
-        if module in HEAVY_IMPORTS:
-            row[module] = row.get(module, 0.0) + seconds
-    table = pd.DataFrame(list(rows.values())).fillna(0.0)
-    columns = ["rule", "jobs", "imports_s", *[m for m in HEAVY_IMPORTS if m in table]]
-    return table[columns].sort_values("imports_s", ascending=False)
+def run(command: list[str], work: Path) -> tuple[float, str]:
+    """Run ``command`` in the copy; wall time, s, and what it printed."""
+    start = time.perf_counter()
+    done = subprocess.run(
+        command, cwd=work, capture_output=True, text=True, env=environment(work),
+        stdin=subprocess.DEVNULL,
+    )  # fmt: skip
+    elapsed = time.perf_counter() - start
+    if done.returncode != 0:
+        sys.stderr.write(done.stdout[-4000:] + done.stderr[-4000:])
+        raise SystemExit(f"failed in {work}: {' '.join(command)}")
+    return elapsed, done.stdout + done.stderr
 
 
-def report(args, timings: dict, jobs: pd.DataFrame, phases: pd.DataFrame) -> None:
-    """Print the figures of one benchmark run."""
-    per_rule = (
-        jobs.groupby("rule", sort=False)
-        .agg(jobs=("job", "count"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"))
+def one_round(work: Path, cores: int) -> dict:
+    """Every scenario once, in order, in a fresh copy: name -> (wall s, rules of the jobs)."""
+    copy_checkout(work)
+    timings = {}
+    for name, args, overlay, _, _ in SCENARIOS:
+        if overlay:
+            (work / f"bench_{name}.yaml").write_text(overlay)
+        command = [sys.executable, "-m", "snakemake", "--cores", str(cores), *args]
+        wall, printed = run(command, work)
+        timings[name] = (wall, _JOB_LINE.findall(printed))
+        print(f"  {name}: {wall:.1f} s, {len(timings[name][1])} jobs", flush=True)
+    return timings
+
+
+def per_rule(out: Path) -> pd.DataFrame:
+    """Per rule of a run: jobs and their summed wall and CPU time, s (benchmark files)."""
+    rows = []
+    for path in sorted((out / "benchmarks").rglob("*.tsv")):
+        table = pd.read_csv(path, sep="\t")
+        relative = path.relative_to(out / "benchmarks")
+        grouped = len(relative.parts) > 1 and relative.parts[0] not in ("tables", "figures")
+        rule = relative.parts[0] if grouped else relative.stem
+        wall, cpu = table["s"].iloc[-1], table["cpu_time"].iloc[-1]
+        rows.append({"rule": rule, "wall_s": wall, "cpu_s": cpu})
+    table = pd.DataFrame(rows)
+    if table.empty:
+        return table
+    return (
+        table.groupby("rule")
+        .agg(jobs=("rule", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"))
         .sort_values("wall_s", ascending=False)
     )
-    busy = jobs["wall_s"].sum()
-    total_s = timings["total_s"]
-    print(f"machine: {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f} (after the run)")
-    if "fresh_s" in timings:
-        print(f"rebuild, numba cache empty (fresh clone), --cores {args.cores}: "
-              f"{timings['fresh_s']:.1f} s (target <= {TARGET_S['fresh']:.0f} s)")  # fmt: skip
-    print(f"full rebuild, warm numba cache, --cores {args.cores}: {total_s:.1f} s "
-          f"(target <= {TARGET_S['rebuild']:.0f} s)")  # fmt: skip
-    print(f"  parse + DAG (dry run): {timings['dag_s']:.1f} s")
-    print(f"  job wall time, summed over {len(jobs)} jobs: {busy:.1f} s")
-    print(f"  ideal with {args.cores} cores: {busy / args.cores:.1f} s; the rest is Snakemake")
-    print(f"  (parsing, scheduling, job start-up outside the job) and dependency waits: "
-          f"{total_s - busy / args.cores:.1f} s")  # fmt: skip
-    figures = jobs[jobs["job"].str.startswith("figures/")]
-    slowest = figures.loc[figures["wall_s"].idxmax()]
-    print(f"slowest figure job: {slowest['rule']} {slowest['wall_s']:.1f} s "
-          f"(target <= {TARGET_S['figure_job']:.0f} s)")  # fmt: skip
-    reran = ", ".join(timings["restyle_rules"])
-    print(f"restyle {RESTYLED[0]}: snakemake call {timings['restyle_s']:.1f} s, reran "
-          f"{reran}; the {RESTYLED[1]} job {timings['restyle_job_s']:.1f} s "
-          f"(target <= {TARGET_S['restyle']:.0f} s)\n")  # fmt: skip
-    print(per_rule.to_string(float_format=lambda v: f"{v:.1f}"))
-    if len(phases):
-        print("\nsimulation jobs, s:")
-        print(phases.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+
+
+def verdict(conditions: Conditions, seconds: float, target, stretch) -> str:
+    if target is None:
+        return ""
+    text = f"target <= {target:.0f} s: {conditions.verdict(seconds <= target)}"
+    if stretch is not None:
+        text += f"; stretch <= {stretch:.0f} s: {conditions.verdict(seconds <= stretch)}"
+    return text
+
+
+def summarise(rounds: list[dict], conditions: Conditions) -> None:
+    print(f"\nbest of {len(rounds)} interleaved round(s), --cores as given:")
+    for name, _, _, target, stretch in SCENARIOS:
+        wall, rules = min((r[name] for r in rounds), key=lambda pair: pair[0])
+        ran = sorted(set(rules))
+        shown = ", ".join(ran) if len(ran) <= 6 else f"{len(ran)} rules"
+        print(f"  {name:9s} {wall:6.1f} s  {len(rules):3d} jobs ({shown})  "
+              f"{verdict(conditions, wall, target, stretch)}")  # fmt: skip
+    simulated = [r for r in rounds[-1]["analysis"][1] if r in ("simulate", "virtual_experiment")]
+    print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none)")
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--cores", type=int, default=2)
-    parser.add_argument("--configfile", type=Path, nargs="*", default=[])
-    parser.add_argument("--keep", type=Path, help="work here and keep the results")
-    parser.add_argument("--json", type=Path, help="also write the timings here")
-    parser.add_argument("--fresh", action="store_true", help="also rebuild, numba cache empty")
-    parser.add_argument(
-        "--imports", action="store_true", help="also: import time per rule (one-core rebuild)"
-    )
+    parser.add_argument("--repeat", type=int, default=3, help="interleaved rounds")
+    parser.add_argument("--no-tests", action="store_true", help="skip the test suite")
+    parser.add_argument("--keep", type=Path, help="work under this folder and keep it")
     args = parser.parse_args(argv)
-
-    configfiles = [path.resolve() for path in args.configfile]
-    work = args.keep or Path(tempfile.mkdtemp(prefix="bench_pipeline_"))
-    if work.exists() and args.keep:
-        shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True, exist_ok=True)
-    copy_checkout(work, numba_cache=not args.fresh)
-    extra = ["--configfile", *map(str, configfiles)] if configfiles else []
-    timings = {"cores": args.cores, "configfiles": [str(p) for p in configfiles]}
+    base = args.keep or Path(tempfile.mkdtemp(prefix="bench_pipeline_"))
+    conditions = Conditions()
+    rounds = []
     try:
-        timings["dag_s"], _ = snakemake(["-n", "--cores", str(args.cores), *extra], work)
-        if args.fresh:
-            timings["fresh_s"], _ = snakemake(["--cores", str(args.cores), *extra], work)
-        forced = ["--forceall"] if args.fresh else []
-        timings["total_s"], _ = snakemake(["--cores", str(args.cores), *forced, *extra], work)
-        out = work / "results" / run_name(configfiles)
-        jobs = benchmark_table(out)
-        phases = simulate_phases(out, jobs)
-        timings["restyle_s"], timings["restyle_rules"] = restyle(work, args.cores, extra)
-        again = benchmark_table(out)
-        timings["restyle_job_s"] = float(again.loc[again["rule"] == RESTYLED[1], "wall_s"].iloc[0])
-        imports = import_table(work, extra) if args.imports else None
+        for k in range(args.repeat):
+            work = base / f"round{k}"
+            shutil.rmtree(work, ignore_errors=True)
+            conditions.sample(f"before round {k + 1}")
+            rounds.append(one_round(work, args.cores))
+            conditions.sample(f"after round {k + 1}")
+        print("\nthe paper run of the last round, per rule (job wall and CPU, s):")
+        print(per_rule(work / "results" / "paper").to_string(float_format=lambda v: f"{v:.1f}"))
+        summarise(rounds, conditions)
+        if not args.no_tests:
+            conditions.sample("before the tests")
+            tests = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+            wall, printed = run(tests, work)
+            conditions.sample("after the tests")
+            closing = printed.strip().splitlines()[-1]
+            print(f"  tests     {wall:6.1f} s  ({closing})  "
+                  f"{verdict(conditions, wall, TESTS_TARGET_S, None)}")  # fmt: skip
     finally:
         if not args.keep:
-            shutil.rmtree(work, ignore_errors=True)
-    report(args, timings, jobs, phases)
-    if imports is not None:
-        jobs_only = imports[imports["jobs"] > 0]
-        print("\nimports per rule (one-core rebuild, PYTHONPROFILEIMPORTTIME), s:")
-        print(imports.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
-        print(f"all jobs: {jobs_only['imports_s'].sum():.1f} s of imports in "
-              f"{int(jobs_only['jobs'].sum())} jobs")  # fmt: skip
-        timings["imports"] = imports.to_dict("records")
-    if args.json:
-        timings |= {"jobs": jobs.to_dict("records"), "simulate_phases": phases.to_dict("records")}
-        args.json.write_text(json.dumps(timings, indent=2, sort_keys=True) + "\n")
+            shutil.rmtree(base, ignore_errors=True)
     return 0
 
 
