@@ -289,10 +289,10 @@ BAD_CONFIGS = {
         on("launch", "v0_min_m_s"),
         "less than or equal to the minimum of 0",
     ),
-    "count >= 1": (
-        setter("launch", "count", value=0),
+    "count >= 3": (
+        setter("launch", "count", value=2),
         on("launch", "count"),
-        "less than the minimum of 1",
+        "less than the minimum of 3",
     ),
     "time step > 0": (
         setter("simulation", "time_step_s", value=0.0),
@@ -451,7 +451,7 @@ BAD_CONFIGS = {
         "'eta' was unexpected",
     ),
     "virtual: impact speeds > 0": (
-        setter("experiment", "virtual", "impact_speeds_m_s", value=[0.4, -1.0]),
+        setter("experiment", "virtual", "impact_speeds_m_s", value=[0.4, -1.0, 1.0]),
         on("experiment", "virtual", "impact_speeds_m_s", 1),
         "less than or equal to the minimum of 0",
     ),
@@ -476,7 +476,7 @@ BAD_CONFIGS = {
         "less than or equal to the minimum of 0",
     ),
     "virtual: speeds or heights": (
-        setter("experiment", "virtual", "drop_heights_m", value=[0.05]),
+        setter("experiment", "virtual", "drop_heights_m", value=[0.05, 0.1, 0.2]),
         key("experiment.virtual.drop_heights_m"),
         "give impact_speeds_m_s or drop_heights_m, not both",
     ),

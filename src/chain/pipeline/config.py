@@ -363,8 +363,10 @@ def check_config(config: Mapping) -> None:
     _check_experiment(config)
     # Imported here: the ablation module pulls in the analysis (pandas, the delay fits).
     from chain.pipeline.ablation import check_ablation
+    from chain.pipeline.config_bounds import check_bounds
 
     check_ablation(config)
+    check_bounds(config, check_config)  # chain.pipeline.config_bounds: bounds needing 2 keys
 
 
 @dataclass(frozen=True)
