@@ -8,6 +8,31 @@
 # (tables/ablation_exponent_all.csv).
 
 
+from chain.pipeline.ablation import overrides_text
+
+
+wildcard_constraints:
+    variant="|".join(PLAN.ablation) or "no-variant",
+
+
+def ablation_settings(wildcards):
+    """Per replicate, the VirtualExperiment fields of every chain of one variant."""
+    return PLAN.ablation_settings(wildcards.variant)
+
+
+def ablation_tolerance(wildcards):
+    return PLAN.ablation_tolerance(wildcards.variant)
+
+
+def ablation_names(which):
+    """Variants of tables/ablation_exponent<which>.csv: "" the default run's, "_all" all."""
+    return PLAN.ablation_names(full=which == "_all")
+
+
+def ablation_fit_files(which):
+    return [f"{OUT}/ablation/{name}_fits.csv" for name in ablation_names(which)]
+
+
 rule ablation:
     input:
         f"{TABLES}/ablation_exponent_all.csv",
@@ -30,7 +55,7 @@ rule ablation_variant:
         settings=ablation_settings,
         tolerance=ablation_tolerance,
         estimators=[config["analysis"]["main_estimator"]],
-        series=VIRTUAL_NAME,
+        series=PLAN.virtual_name,
     script:
         "../scripts/ablation_variant.py"
 
@@ -53,6 +78,6 @@ rule ablation_table:
         ENV
     params:
         variants=lambda wildcards: ablation_names(wildcards.which),
-        overrides={name: overrides_text(v) for name, v in ABLATION.items()},
+        overrides={name: overrides_text(v) for name, v in PLAN.ablation.items()},
     script:
         "../scripts/ablation_table.py"

@@ -12,10 +12,44 @@
 # experiment/<name>_N<N>_traces.csv, which the pulses rule analyses with the simulated
 # traces; selection applies the 5 % amplitude match (chain.analysis.selection.select_shots) and
 # writes experiment/selection.csv, which the delays and ssw rules use to drop rejected
-# collision shots. The parts, the label and the input functions are in common.smk.
+# collision shots. The parts and the label are the plan's (PLAN.experiment).
 # Measured datasets are checked when the DAG is built (common.smk); a shot with a dead
 # or saturated channel stops the run there, or with experiment.bad_channels: skip is
 # left out of the traces and listed in selection.csv with the channel as the reason.
+
+
+def raw_dataset(n):
+    """Folder of the virtual experiment's dataset of the chain of n beads."""
+    return f"{OUT}/experiment/raw/N{n}"
+
+
+def experiment_datasets():
+    """Each experiment dataset: its folder, series name, N and trace file."""
+    return [
+        {
+            "folder": raw_dataset(part.n_beads) if part.folder is None else part.folder,
+            "name": part.name,
+            "N": part.n_beads,
+            "traces": trace_file("experiment", part.name, part.n_beads),
+        }
+        for part in PLAN.experiment
+    ]
+
+
+def experiment_dataset_files():
+    """What loading the datasets depends on: the virtual experiment's folders, or the
+    measured datasets' metadata.yaml and shot files (editing one reloads them)."""
+    return [
+        path
+        for part in PLAN.experiment
+        for path in ([raw_dataset(part.n_beads)] if part.folder is None else part.files)
+    ]
+
+
+def virtual_settings(wildcards):
+    """The VirtualExperiment fields of one chain (plain values: a changed one reruns
+    the job; RunPlan.virtual_settings)."""
+    return PLAN.virtual_settings(int(wildcards.N))
 
 
 rule virtual_experiment:
@@ -38,7 +72,7 @@ rule virtual_experiment:
         runtime=VIRTUAL_EXPERIMENT_JOB["runtime"],
     params:
         settings=virtual_settings,
-        dataset=VIRTUAL_NAME,
+        dataset=PLAN.virtual_name,
     script:
         "../scripts/virtual_experiment.py"
 

@@ -23,6 +23,14 @@ rule fig1_setup:
         "../scripts/fig1_setup.py"
 
 
+def fig2_trace_files(wildcards):
+    """Experiment chains shown in Fig. 2: those in figures.traces_N when it is set
+    (all of them if it names none), else all."""
+    chosen = config["figures"]["traces_N"]
+    shown = [part for part in EXPERIMENT_PARTS if not chosen or part[2] in chosen]
+    return [trace_file(*part) for part in shown or EXPERIMENT_PARTS]
+
+
 rule fig2_experiment_traces:
     input:
         traces=fig2_trace_files,
@@ -51,7 +59,7 @@ rule fig3_simulation_traces:
     input:
         traces=[
             trace_file("simulation", config["figures"]["traces_model"], n)
-            for n in TRACES_N
+            for n in PLAN.traces_n
         ],
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
@@ -113,7 +121,7 @@ rule fig5_ssw_vs_force:
         ENV
     params:
         experiment_label=experiment_label,
-        sensors={n: c["sensors"] for n, c in CHAINS.items()},
+        sensors={n: list(s) for n, s in PLAN.chains.items()},
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -138,14 +146,17 @@ rule fig_parity_ssw_vs_N:
 
 # The SSW along the chain (issue 13): field of one collision per chain of the first
 # conservative model (where the SSW is a clean wave), or of Fig. 3's model if none.
-SPACETIME_MODEL = CONSERVATIVE[0] if CONSERVATIVE else config["figures"]["traces_model"]
+SPACETIME_MODEL = PLAN.spacetime_model
 
 
 rule ssw_spacetime:
     input:
-        fields=[f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in TRACES_N],
+        fields=[
+            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in PLAN.traces_n
+        ],
         long_fields=[
-            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in LONG_CHAINS
+            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv"
+            for n in PLAN.long_chains
         ],
         track=f"{TABLES}/ssw_track.csv",
         lib=code("fig_ssw_spacetime"),
@@ -159,8 +170,8 @@ rule ssw_spacetime:
         ENV
     params:
         model=SPACETIME_MODEL,
-        chains=TRACES_N,
-        long_chains=LONG_CHAINS,
+        chains=list(PLAN.traces_n),
+        long_chains=list(PLAN.long_chains),
     script:
         "../scripts/fig_ssw_spacetime.py"
 
