@@ -53,7 +53,7 @@ def code(script):
 # ---- trace files ----------------------------------------------------------------
 # A "part" is one trace file: (source, model, N). The simulation gives one per model
 # and chain; the experiment one per chain of PLAN.experiment (virtual: written to
-# experiment/raw/N<N>/ by rule virtual_experiment; measured: a dataset folder of
+# experiment/raw/N<N>/ by the virtual_experiment rule; measured: a dataset folder of
 # experiment.datasets). The analysis reads them all.
 SIMULATION_PARTS = [("simulation", m, n) for m in PLAN.models for n in PLAN.chains]
 EXPERIMENT_PARTS = [("experiment", part.name, part.n_beads) for part in PLAN.experiment]

@@ -18,38 +18,7 @@
 # left out of the traces and listed in selection.csv with the channel as the reason.
 
 
-def raw_dataset(n):
-    """Folder of the virtual experiment's dataset of the chain of n beads."""
-    return f"{OUT}/experiment/raw/N{n}"
-
-
-def experiment_datasets():
-    """Each experiment dataset: its folder, series name, N and trace file."""
-    return [
-        {
-            "folder": raw_dataset(part.n_beads) if part.folder is None else part.folder,
-            "name": part.name,
-            "N": part.n_beads,
-            "traces": trace_file("experiment", part.name, part.n_beads),
-        }
-        for part in PLAN.experiment
-    ]
-
-
-def experiment_dataset_files():
-    """What loading the datasets depends on: the virtual experiment's folders, or the
-    measured datasets' metadata.yaml and shot files (editing one reloads them)."""
-    return [
-        path
-        for part in PLAN.experiment
-        for path in ([raw_dataset(part.n_beads)] if part.folder is None else part.files)
-    ]
-
-
-def virtual_settings(wildcards):
-    """The VirtualExperiment fields of one chain (plain values: a changed one reruns
-    the job; RunPlan.virtual_settings)."""
-    return PLAN.virtual_settings(int(wildcards.N))
+include: "experiment_inputs.smk"
 
 
 rule virtual_experiment:

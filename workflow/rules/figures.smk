@@ -23,14 +23,6 @@ rule fig1_setup:
         "../scripts/fig1_setup.py"
 
 
-def fig2_trace_files(wildcards):
-    """Experiment chains shown in Fig. 2: those in figures.traces_N when it is set
-    (all of them if it names none), else all."""
-    chosen = config["figures"]["traces_N"]
-    shown = [part for part in EXPERIMENT_PARTS if not chosen or part[2] in chosen]
-    return [trace_file(*part) for part in shown or EXPERIMENT_PARTS]
-
-
 rule fig2_experiment_traces:
     input:
         traces=fig2_trace_files,

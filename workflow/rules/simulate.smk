@@ -6,10 +6,6 @@
 # On a fresh clone the first job of each model compiles that model's numba kernel (10 s);
 # the first chain of every model goes ahead of the others, so that the first jobs
 # compile different kernels side by side and the rest load them from numba's cache.
-def simulate_priority(wildcards):
-    return 4 if int(wildcards.N) == next(iter(PLAN.chains)) else 3
-
-
 rule simulate:
     input:
         code("simulate"),
@@ -20,9 +16,8 @@ rule simulate:
         f"{LOGS}/simulate/{{model}}_N{{N}}.log",
     benchmark:
         f"{BENCH}/simulate/{{model}}_N{{N}}.tsv"
-    # First (3-4, see simulate_priority), with the virtual experiment (3); long side
-    # jobs next (1).
-    priority: simulate_priority
+    # First (3-4, see above), with the virtual experiment (3); long side jobs next (1).
+    priority: lambda wildcards: 4 if int(wildcards.N) == next(iter(PLAN.chains)) else 3
     conda:
         ENV
     threads: simulate_threads
