@@ -13,7 +13,7 @@ import yaml
 from snakemake.utils import validate
 
 from chain.apparatus.virtual import VirtualExperiment, plan_shots, simulate_virtual_shots
-from chain.errors import ParameterError
+from chain.errors import ConfigError, ParameterError
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
 from chain.pipeline.ablation import (
@@ -23,7 +23,7 @@ from chain.pipeline.ablation import (
     variant_settings,
     variant_tolerance,
 )
-from chain.pipeline.config import ConfigError, virtual_experiment_settings
+from chain.pipeline.virtual_config import virtual_experiment_settings
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -57,7 +57,7 @@ def test_bead_launch_with_point_readout_is_the_papers_simulation():
     """launch="bead" and readout="felt" make the apparatus model the paper's simulation:
     the same forces as chain.physics.simulation.simulate on a plain chain (same step),
     for a collision and a reference shot, with dissipation."""
-    settings = dataclasses.replace(SMALL, launch="bead", readout="felt", eta=0.58e-6)
+    settings = dataclasses.replace(SMALL, launch="bead", readout="felt", eta_s=0.58e-6)
     plan = pd.DataFrame(
         {"kind": ["collision", "reference"], "v_left_m_s": 0.1, "v_right_m_s": [0.1, 0.0]}
     ).assign(delay_s=0.0)
@@ -149,7 +149,7 @@ def test_variants_map_config_keys(paper):
     assert again["seed"] == plain["seed"] + 2000
     heavy = variant_settings(paper, variants["heavy_striker"], chain["N"], chain["sensors"])
     assert heavy["striker_radius"] == 0.013
-    assert variant_settings(paper, variants["no_kuwabara_kono"], 25, [9, 17])["eta"] == 0.0
+    assert variant_settings(paper, variants["no_kuwabara_kono"], 25, [9, 17])["eta_s"] == 0.0
     assert variant_tolerance(paper, variants["no_selection"]) is None
     assert variant_tolerance(paper, variants["as_configured"]) == 0.05
     check_ablation(paper)

@@ -18,9 +18,10 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
-from chain.pipeline.config import ConfigError, check_config, check_finite, experiment_parts
+from chain.errors import ConfigError
+from chain.pipeline.config import check_config, check_finite
 from chain.pipeline.config_files import check_config_file
-from chain.pipeline.datasets import check_experiment_datasets
+from chain.pipeline.datasets import check_experiment_datasets, experiment_parts
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"

@@ -21,8 +21,12 @@ from hypothesis import strategies as st
 
 from chain.apparatus.dataset_check import check_dataset
 from chain.apparatus.measured import MeasuredDataError, load_dataset
-from chain.pipeline.config import ConfigError, experiment_parts
-from chain.pipeline.datasets import check_experiment_datasets, skipped_shot_rows
+from chain.errors import ConfigError
+from chain.pipeline.datasets import (
+    check_experiment_datasets,
+    experiment_parts,
+    skipped_shot_rows,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "tests" / "data" / "virtual_small"

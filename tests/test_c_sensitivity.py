@@ -16,6 +16,7 @@ from chain.pipeline.c_sensitivity import (
     sensitivity_plan,
     shifted_pairs,
 )
+from chain.pipeline.plan import launch_speeds
 from chain.report.fig_c_sensitivity import fig_c_sensitivity
 from chain.report.spread import ablation_summary, c_spread_summary, spread_markdown_rows
 
@@ -33,7 +34,7 @@ def test_shifted_pairs_stay_inside_the_chain():
 def test_plan_of_the_paper_config():
     config = yaml.safe_load((ROOT / "config.yaml").read_text())
     validate(config, str(ROOT / "workflow" / "schemas" / "config.schema.yaml"))
-    plan = sensitivity_plan(config)
+    plan = sensitivity_plan(config, launch_speeds(config["launch"]))
     assert plan["eta_s"] == pytest.approx([0.0, 0.58e-6, 1.16e-6])
     assert plan["shifts"] == [2, -2, -4]
     assert len(plan["speeds_m_s"]) == 12

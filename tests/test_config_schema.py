@@ -17,8 +17,10 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
 from chain.analysis.pulses import ESTIMATORS
+from chain.errors import ConfigError
 from chain.physics.materials import MATERIALS
-from chain.pipeline.config import ConfigError, check_config, experiment_parts, key_name
+from chain.pipeline.config import check_config, key_name
+from chain.pipeline.datasets import experiment_parts
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -121,23 +123,24 @@ def test_virtual_settings_map_onto_the_virtual_experiment(paper):
     from dataclasses import fields
 
     from chain.apparatus.virtual import VirtualExperiment
-    from chain.pipeline.config import VIRTUAL_FIELDS, virtual_experiment_settings
+    from chain.pipeline.virtual_config import VIRTUAL_KEYS, virtual_experiment
 
+    # The config's keys are the fields' names: experiment.virtual passes on as it is.
     schema = load(SCHEMA)["properties"]["experiment"]["properties"]["virtual"]["properties"]
-    assert set(VIRTUAL_FIELDS) == set(schema)
-    assert set(VIRTUAL_FIELDS.values()) <= {f.name for f in fields(VirtualExperiment)}
+    assert set(VIRTUAL_KEYS) == set(schema)
+    assert set(VIRTUAL_KEYS) < {f.name for f in fields(VirtualExperiment)}
     config = validated(paper)
-    settings = VirtualExperiment.from_dict(virtual_experiment_settings(config, 26, [10, 17]))
+    settings = virtual_experiment(config, 26, [10, 17])
     assert settings.n_beads == 26 and settings.sensor_beads == (10, 17)
     assert settings.seed == config["seed"] + 26
     assert settings.striker_radius == config["setup"]["striker_radius_m"] == 0.004
     assert settings.radius == 0.013 and settings.material == "steel_100C6"
-    assert settings.eta == 0.58e-6 and settings.sensor_stiffness == 1.9e9
+    assert settings.eta_s == 0.58e-6 and settings.sensor_stiffness_N_per_m == 1.9e9
     assert settings.collision_shots == 3 and settings.reference_shots == 2
 
 
 def test_experiment_parts_and_labels(paper):
-    from chain.pipeline.config import experiment_label
+    from chain.pipeline.datasets import experiment_label
 
     config = validated(paper)
     virtual = experiment_parts(config)

@@ -42,7 +42,7 @@ def test_without_candidates_the_chain_is_the_uniform_one():
     assert np.all(radii == TINY.radius) and np.all(gaps == 0.0)
     model = apparatus_chain(TINY, "both", radii)
     plain = uniform_chain(
-        10, radius=TINY.radius, eta=TINY.eta, sensor_beads=(3, 8), striker_radius=4e-3
+        10, radius=TINY.radius, eta=TINY.eta_s, sensor_beads=(3, 8), striker_radius=4e-3
     )
     np.testing.assert_array_equal(model.masses, plain.masses)
     np.testing.assert_array_equal(model.link_stiffness, plain.link_stiffness)

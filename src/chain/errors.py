@@ -1,8 +1,9 @@
-"""The library's error type and the checks of input values that raise it.
+"""The library's error types and the checks of input values that raise them.
 
 Every public function checks its inputs with these and raises
 :class:`ParameterError` with a message that names the parameter, never a numpy
-traceback from deep inside a kernel.
+traceback from deep inside a kernel. The pipeline raises :class:`ConfigError` for a
+bad config, its message naming the key (:func:`key_label`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,10 @@ import numpy as np
 
 class ParameterError(ValueError):
     """An input value is outside its physical range; the message names the parameter."""
+
+
+class ConfigError(ValueError):
+    """A configuration value is inconsistent; the message names the key."""
 
 
 def require_positive(name: str, value: float) -> float:

@@ -8,6 +8,9 @@
 # (tables/ablation_exponent_all.csv).
 
 
+include: "ablation_inputs.smk"
+
+
 rule ablation:
     input:
         f"{TABLES}/ablation_exponent_all.csv",
@@ -30,7 +33,7 @@ rule ablation_variant:
         settings=ablation_settings,
         tolerance=ablation_tolerance,
         estimators=[config["analysis"]["main_estimator"]],
-        series=VIRTUAL_NAME,
+        series=PLAN.virtual_name,
     script:
         "../scripts/ablation_variant.py"
 
@@ -53,6 +56,6 @@ rule ablation_table:
         ENV
     params:
         variants=lambda wildcards: ablation_names(wildcards.which),
-        overrides={name: overrides_text(v) for name, v in ABLATION.items()},
+        overrides={name: overrides_text(v) for name, v in PLAN.ablation.items()},
     script:
         "../scripts/ablation_table.py"

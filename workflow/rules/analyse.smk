@@ -128,9 +128,9 @@ rule c_sensitivity:
     conda:
         ENV
     params:
-        plan=sensitivity_plan(config),
-        material=config["material"],
-        radius_m=config["radius_m"],
+        plan=PLAN.c_sensitivity,
+        # Every input of each simulation of the study (RunPlan.c_sensitivity_jobs).
+        jobs=PLAN.c_sensitivity_jobs(),
     script:
         "../scripts/c_sensitivity.py"
 
@@ -159,13 +159,7 @@ rule ssw_track:
         mem_mb=simulate_mem_mb,
         runtime=simulate_runtime,
     params:
-        material=config["material"],
-        radius_m=config["radius_m"],
-        eta_s=lambda wildcards: MODELS[wildcards.model]["eta_s"],
-        sensors=lambda wildcards: chain_sensors(int(wildcards.N)),
-        speeds_m_s=SPEEDS,
-        simulation=config["simulation"],
-        duration_s=lambda wildcards: simulated_duration(int(wildcards.N)),
+        job=simulate_job,
         representative_force_N=config["figures"]["representative_force_N"],
         representative_index=config["figures"]["representative_index"],
     script:
@@ -176,8 +170,8 @@ rule ssw_speed:
     input:
         tracks=[
             f"{OUT}/simulation/{model}_N{n}_ssw_track.csv"
-            for model in MODELS
-            for n in TRACKED_N
+            for model in PLAN.models
+            for n in PLAN.tracked_chains
         ],
         lib=code("ssw_speed"),
     output:

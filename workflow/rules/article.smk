@@ -17,7 +17,7 @@ rule article:
         summary=f"{OUT}/summary.json",
         delays=f"{TABLES}/delays.csv",
         ssw=f"{TABLES}/ssw.csv",
-        figures=[figure(name)[0] for name in figure_names()],
+        figures=[figure(name)[0] for name in PLAN.figure_names()],
         lib=code("article"),
     output:
         f"{OUT}/article.pdf",

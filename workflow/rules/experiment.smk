@@ -12,10 +12,13 @@
 # experiment/<name>_N<N>_traces.csv, which the pulses rule analyses with the simulated
 # traces; selection applies the 5 % amplitude match (chain.analysis.selection.select_shots) and
 # writes experiment/selection.csv, which the delays and ssw rules use to drop rejected
-# collision shots. The parts, the label and the input functions are in common.smk.
+# collision shots. The parts and the label are the plan's (PLAN.experiment).
 # Measured datasets are checked when the DAG is built (common.smk); a shot with a dead
 # or saturated channel stops the run there, or with experiment.bad_channels: skip is
 # left out of the traces and listed in selection.csv with the channel as the reason.
+
+
+include: "experiment_inputs.smk"
 
 
 rule virtual_experiment:
@@ -38,7 +41,7 @@ rule virtual_experiment:
         runtime=VIRTUAL_EXPERIMENT_JOB["runtime"],
     params:
         settings=virtual_settings,
-        dataset=VIRTUAL_NAME,
+        dataset=PLAN.virtual_name,
     script:
         "../scripts/virtual_experiment.py"
 

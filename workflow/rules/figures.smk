@@ -51,7 +51,7 @@ rule fig3_simulation_traces:
     input:
         traces=[
             trace_file("simulation", config["figures"]["traces_model"], n)
-            for n in TRACES_N
+            for n in PLAN.traces_n
         ],
         pulses=f"{TABLES}/pulses.csv",
         ssw=f"{TABLES}/ssw.csv",
@@ -113,7 +113,7 @@ rule fig5_ssw_vs_force:
         ENV
     params:
         experiment_label=experiment_label,
-        sensors={n: c["sensors"] for n, c in CHAINS.items()},
+        sensors={n: list(s) for n, s in PLAN.chains.items()},
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -138,14 +138,17 @@ rule fig_parity_ssw_vs_N:
 
 # The SSW along the chain (issue 13): field of one collision per chain of the first
 # conservative model (where the SSW is a clean wave), or of Fig. 3's model if none.
-SPACETIME_MODEL = CONSERVATIVE[0] if CONSERVATIVE else config["figures"]["traces_model"]
+SPACETIME_MODEL = PLAN.spacetime_model
 
 
 rule ssw_spacetime:
     input:
-        fields=[f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in TRACES_N],
+        fields=[
+            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in PLAN.traces_n
+        ],
         long_fields=[
-            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv" for n in LONG_CHAINS
+            f"{OUT}/simulation/{SPACETIME_MODEL}_N{n}_field.csv"
+            for n in PLAN.long_chains
         ],
         track=f"{TABLES}/ssw_track.csv",
         lib=code("fig_ssw_spacetime"),
@@ -159,8 +162,8 @@ rule ssw_spacetime:
         ENV
     params:
         model=SPACETIME_MODEL,
-        chains=TRACES_N,
-        long_chains=LONG_CHAINS,
+        chains=list(PLAN.traces_n),
+        long_chains=list(PLAN.long_chains),
     script:
         "../scripts/fig_ssw_spacetime.py"
 

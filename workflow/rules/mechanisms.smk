@@ -10,6 +10,9 @@
 # these rules are left out of the default run (common.smk says so on the console).
 
 
+include: "mechanisms_inputs.smk"
+
+
 rule mechanisms:
     input:
         f"{TABLES}/ssw_mechanisms_all.csv",
@@ -49,7 +52,7 @@ rule lammps_setting:
         ENV
     params:
         config=MECHANISM_CONFIG,
-        sensors=lambda wildcards: CHAINS[int(wildcards.N)]["sensors"],
+        sensors=lambda wildcards: list(PLAN.chains[int(wildcards.N)]),
         estimator=config["analysis"]["main_estimator"],
     script:
         "../scripts/lammps_setting.py"
@@ -85,11 +88,14 @@ rule ssw_mechanisms:
     conda:
         ENV
     params:
-        labels={name: setting_label(*pair) for name, pair in SWEEP_ALL.items()},
-        viscous_labels={
-            name: f"gamma={gamma:g} N s/m" for name, gamma in VISCOUS["_all"].items()
+        labels={
+            name: setting_label(*pair) for name, pair in PLAN.sweep(full=True).items()
         },
-        lammps_reference=FRICTIONLESS,
+        viscous_labels={
+            name: f"gamma={gamma:g} N s/m"
+            for name, gamma in PLAN.viscous(full=True).items()
+        },
+        lammps_reference=PLAN.frictionless,
         candidates=lambda wildcards: candidates_of(wildcards.which),
         candidate_reference=CANDIDATE_REFERENCE,
     script:

@@ -1,14 +1,16 @@
 # The summary beside the paper's numbers, and the HTML report.
 
+from chain.pipeline.mechanisms import FRICTION_MECHANISM, REFERENCE_MECHANISM
+
 
 rule summary:
     input:
         delay_fits=f"{TABLES}/delay_fits.csv",
         ssw_fits=f"{TABLES}/ssw_fits.csv",
         c_sensitivity=f"{TABLES}/c_sensitivity.csv",
-        ablation=ABLATION_TABLES,
-        mechanisms=MECHANISM_TABLES,
-        lammps_check=LAMMPS_TARGETS,
+        ablation=PLAN.optional_table("ablation_exponent"),
+        mechanisms=PLAN.optional_table("ssw_mechanisms"),
+        lammps_check=PLAN.optional_table("lammps_check"),
         pulses=f"{TABLES}/pulses.csv",
         delays=f"{TABLES}/delays.csv",
         ssw=f"{TABLES}/ssw.csv",
@@ -28,7 +30,7 @@ rule summary:
         run_name=RUN,
         material=config["material"],
         radius_m=config["radius_m"],
-        conservative_models=CONSERVATIVE,
+        conservative_models=list(PLAN.conservative),
         estimator=config["analysis"]["main_estimator"],
         experiment_label=experiment_label,
         tolerance=config["experiment"]["tolerance"],

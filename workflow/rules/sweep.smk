@@ -22,7 +22,7 @@ rule sweep_table:
     conda:
         ENV
     params:
-        eta_s={name: m["eta_s"] for name, m in MODELS.items()},
+        eta_s=PLAN.models,
         estimator=config["analysis"]["main_estimator"],
     script:
         "../scripts/sweep_table.py"

@@ -6,7 +6,8 @@ from _logging import start
 from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 
 log = start(snakemake)
-settings = VirtualExperiment.from_dict(snakemake.params.settings)
+# The chain's settings (RunPlan.virtual_settings): the fields under the config's names.
+settings = VirtualExperiment(**snakemake.params.settings)
 speeds = settings.nominal_speeds
 log.info(
     "N = %d, sensors %s, %d amplitudes (%.3g..%.3g m/s), %d collision + %d reference shots "

@@ -35,6 +35,14 @@ CHAIN_STREAM = 24
 #: Fields drawn once per chain (non-negative).
 _CHAIN_FIELDS = ("radius_dispersion", "gap_mean_m", "gap_spread_m")
 
+#: Field names of datasets written before the fields took the config's names (issue
+#: 31) -> today's names, so that :meth:`VirtualExperiment.from_dataset` reads them.
+_LEGACY_FIELDS = {
+    "eta": "eta_s",
+    "drag_rate": "drag_rate_per_s",
+    "sensor_stiffness": "sensor_stiffness_N_per_m",
+}
+
 #: Default nominal impact speeds, m/s: incident amplitudes of about 9-90 N at the first
 #: sensor of the paper's chains (drop heights 8 mm to 32 cm).
 DEFAULT_IMPACT_SPEEDS_M_S = (0.4, 0.6, 0.8, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
@@ -43,6 +51,9 @@ DEFAULT_IMPACT_SPEEDS_M_S = (0.4, 0.6, 0.8, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5
 @dataclass(frozen=True)
 class VirtualExperiment:
     """Settings of the virtual experiment (a model of the paper's apparatus).
+
+    The fields a pipeline config sets carry the names of its ``experiment.virtual``
+    keys (units in the name), so a config section is passed on as it is.
 
     Attributes
     ----------
@@ -56,11 +67,11 @@ class VirtualExperiment:
         Bead radius, m (paper: 13e-3).
     striker_radius : float
         Striker radius, m (paper: 4e-3).
-    eta : float
+    eta_s : float
         Kuwabara-Kono relaxation time, s (paper: 0.58e-6).
-    drag_rate : float
+    drag_rate_per_s : float
         Track friction rate gamma, 1/s: every particle feels -m gamma v (0: none).
-    sensor_stiffness : float
+    sensor_stiffness_N_per_m : float
         Stiffness of the sensor between the halves of a split bead, N/m
         (PCB 200B02: 1.9e9).
     sensitivity_mV_per_N : float or tuple of float
@@ -123,9 +134,9 @@ class VirtualExperiment:
     material: str | Material = "steel_100C6"
     radius: float = PAPER_BEAD_RADIUS
     striker_radius: float = PAPER_STRIKER_RADIUS
-    eta: float = 0.58e-6
-    drag_rate: float = 0.0
-    sensor_stiffness: float = PCB_200B02_STIFFNESS
+    eta_s: float = 0.58e-6
+    drag_rate_per_s: float = 0.0
+    sensor_stiffness_N_per_m: float = PCB_200B02_STIFFNESS
     sensitivity_mV_per_N: float | tuple[float, ...] = PCB_200B02_SENSITIVITY_MV_PER_N
     impact_speeds_m_s: tuple[float, ...] | None = None
     drop_heights_m: tuple[float, ...] | None = None
@@ -157,9 +168,9 @@ class VirtualExperiment:
         object.__setattr__(self, "sensor_beads", beads)
         if not isinstance(self.material, Material):
             get_material(self.material)
-        for name in ("radius", "striker_radius", "sensor_stiffness", "sampling_interval_s"):
+        for name in ("radius", "striker_radius", "sensor_stiffness_N_per_m", "sampling_interval_s"):
             require_positive(name, getattr(self, name))
-        for name in ("eta", "drag_rate", "timing_jitter_s", "noise_N", *_CHAIN_FIELDS):
+        for name in ("eta_s", "drag_rate_per_s", "timing_jitter_s", "noise_N", *_CHAIN_FIELDS):
             require_nonnegative(name, getattr(self, name))
         if self.radius_dispersion >= 0.1:
             raise ParameterError(
@@ -225,6 +236,9 @@ class VirtualExperiment:
             raise ParameterError(f"{path}: not written by the virtual experiment")
         for key in ("model", "generator"):
             apparatus.pop(key, None)
+        for old, new in _LEGACY_FIELDS.items():
+            if old in apparatus:
+                apparatus[new] = apparatus.pop(old)
         if isinstance(apparatus.get("material"), Mapping):
             apparatus["material"] = Material(**apparatus["material"])
         return cls.from_dict(

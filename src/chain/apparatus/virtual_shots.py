@@ -71,10 +71,10 @@ def apparatus_chain(settings: VirtualExperiment, strikers: str, radii) -> ChainM
     mass and each contact with its own Hertz stiffness."""
     material = settings.material_object
     common = dict(
-        eta=settings.eta,
+        eta=settings.eta_s,
         sensor_beads=settings.sensor_beads if settings.readout == "sensor" else (),
-        sensor_stiffness=settings.sensor_stiffness,
-        drag_rate=settings.drag_rate,
+        sensor_stiffness=settings.sensor_stiffness_N_per_m,
+        drag_rate=settings.drag_rate_per_s,
     )
     with_strikers = settings.launch == "striker"
     if np.all(radii == settings.radius):

@@ -28,14 +28,10 @@ import pandas as pd
 from chain.analysis.delays import delay_fit_table, delay_table
 from chain.analysis.rows import flag_unusable
 from chain.analysis.selection import select_shots
-from chain.errors import ParameterError
+from chain.errors import ConfigError, ParameterError
 from chain.errors import key_label as key_name
 from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
-from chain.pipeline.virtual_config import (
-    VIRTUAL_FIELDS,
-    ConfigError,
-    virtual_experiment_settings,
-)
+from chain.pipeline.virtual_config import VIRTUAL_KEYS, virtual_experiment_settings
 
 #: Keys a variant may set besides those of ``experiment.virtual``.
 EXTRA_KEYS = ("striker_radius_m", "tolerance")
@@ -101,8 +97,8 @@ def variant_settings(
     """
     settings = virtual_experiment_settings(config, n_beads, sensors)
     for key, value in variant["set"].items():
-        if key in VIRTUAL_FIELDS:
-            settings[VIRTUAL_FIELDS[key]] = value
+        if key in VIRTUAL_KEYS:
+            settings[key] = value
         elif key == "striker_radius_m":
             settings["striker_radius"] = value
     settings["seed"] += REPLICATE_SEED_STEP * int(replicate)
@@ -140,8 +136,8 @@ def check_ablation(config: Mapping) -> None:
             )
         seen[variant["name"]] = i
         for key in variant["set"]:
-            if key not in VIRTUAL_FIELDS and key not in EXTRA_KEYS:
-                allowed = ", ".join([*VIRTUAL_FIELDS, *EXTRA_KEYS])
+            if key not in VIRTUAL_KEYS and key not in EXTRA_KEYS:
+                allowed = ", ".join([*VIRTUAL_KEYS, *EXTRA_KEYS])
                 raise ConfigError(
                     f"config key {key_name([*path, 'set', key])!r}: unknown; allowed: {allowed}"
                 )

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-import numpy as np
 import pandas as pd
 
 from chain.analysis.delays import delay_fit_table, delay_table
@@ -60,8 +59,15 @@ def shifted_pairs(chains: Mapping[int, Sequence[int]], shift: int) -> dict[int, 
     return pairs
 
 
-def sensitivity_plan(config: Mapping) -> dict:
+def sensitivity_plan(config: Mapping, speeds_m_s: Sequence[float]) -> dict:
     """The choices of a schema-valid config (plain values, for rule params).
+
+    Parameters
+    ----------
+    config : mapping
+        A schema-valid config.
+    speeds_m_s : sequence of float
+        The run's launch speeds, m/s (:attr:`chain.pipeline.plan.RunPlan.speeds`).
 
     Returns
     -------
@@ -73,15 +79,13 @@ def sensitivity_plan(config: Mapping) -> dict:
     """
     chains = {int(c["N"]): [int(b) for b in c["sensors"]] for c in config["chains"]}
     paper_eta = max([m["eta_s"] for m in config["models"]] + [0.0]) or 0.58e-6
-    launch = config["launch"]
-    speeds = np.geomspace(launch["v0_min_m_s"], launch["v0_max_m_s"], launch["count"])
     return {
         "chains": chains,
         "eta_s": [0.0, paper_eta, 2.0 * paper_eta],
         "estimators": list(config["analysis"]["estimators"]),
         "main_estimator": config["analysis"]["main_estimator"],
         "shifts": [s for s in SENSOR_SHIFTS if shifted_pairs(chains, s) is not None],
-        "speeds_m_s": [float(f"{v:.12g}") for v in speeds],
+        "speeds_m_s": [float(v) for v in speeds_m_s],
         "simulation": dict(config["simulation"]),
     }
 

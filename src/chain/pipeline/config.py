@@ -6,14 +6,16 @@ first (types, ranges, defaults; snakemake.utils.validate names the key as
 (:func:`check_finite`, one walk over the whole config: the schema's minimum/maximum let
 NaN through), then the relations between keys (sensor beads inside their chain, the
 Fig. 3 model among the models, a duration long enough for the waves, the virtual
-experiment's settings...), then :func:`experiment_parts` reads the measured datasets'
-metadata and :func:`chain.pipeline.datasets.check_experiment_datasets` checks every
-shot file of them. Every message starts with the dotted name of the offending key, e.g.
-``config key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config
-stops before any job runs and says where.
+experiment's settings...), then :func:`chain.pipeline.datasets.experiment_parts`
+reads the measured datasets' metadata and
+:func:`chain.pipeline.datasets.check_experiment_datasets` checks every shot file of
+them. Every message starts with the dotted name of the offending key, e.g. ``config
+key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config stops
+before any job runs and says where.
 
-:func:`check_config` takes a plain dict and reads no file; :func:`experiment_parts`
-reads the datasets' ``metadata.yaml`` (and nothing else). Neither knows Snakemake.
+:func:`check_config` takes a plain dict, reads no file and knows no Snakemake. What a
+checked config means for the run (speeds, chains, jobs, targets) is derived once, by
+:class:`chain.pipeline.plan.RunPlan`.
 
 Duration check
 --------------
@@ -40,35 +42,21 @@ the record when it is shorter; that is not an error.
 
 from __future__ import annotations
 
-import os
-import re
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
-from pathlib import Path
+from collections.abc import Mapping
 
-from chain.errors import ParameterError, nonfinite_paths
+from chain.errors import ConfigError, ParameterError, nonfinite_paths
 from chain.errors import key_label as key_name
-from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
 from chain.physics.materials import MATERIALS, get_material
 from chain.physics.theory import (
     LAUNCH_VELOCITY_RATIO,
     force_from_bead_velocity,
     pulse_passing_time,
 )
-
-# Re-exported: the config checks and the rules name them from here.
-from chain.pipeline.virtual_config import (  # noqa: F401
-    VIRTUAL_FIELDS,
-    ConfigError,
-    virtual_experiment_settings,
-)
+from chain.pipeline.virtual_config import virtual_experiment
 
 #: The duration must be this many times the time the slowest pulse needs to pass the
 #: far sensor (see the module docstring).
 DURATION_MARGIN = 1.2
-
-#: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
-SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
 
 def _fail(path, message: str):
@@ -137,15 +125,10 @@ def _check_virtual_keys(virtual: Mapping, base: list) -> None:
 
 
 def _virtual_settings_of_chains(config: Mapping, base: list):
-    # Imported here: chain.apparatus.virtual pulls in the simulation core.
-    from chain.apparatus.virtual import VirtualExperiment
-
     settings = None
     for entry in config["chains"]:
         try:
-            settings = VirtualExperiment.from_dict(
-                virtual_experiment_settings(config, entry["N"], entry["sensors"])
-            )
+            settings = virtual_experiment(config, entry["N"], entry["sensors"])
         except ParameterError as error:
             _fail(base, f"{error} (chain N = {entry['N']})")
     return settings
@@ -238,24 +221,6 @@ def _check_chains(config: Mapping) -> dict[int, int]:
                 "an N not in chains",
             )
     return seen_n
-
-
-def long_chain_duration(config: Mapping, n_beads: int) -> float:
-    """Simulated time of a long chain, s: ``long_chains.duration_s``, or by default
-    ``simulation.duration_s`` x N / the largest N of ``chains``.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in).
-    n_beads : int
-        N of the long chain.
-    """
-    duration = config.get("long_chains", {}).get("duration_s")
-    if duration is not None:
-        return float(duration)
-    longest = max(entry["N"] for entry in config["chains"])
-    return float(config["simulation"]["duration_s"]) * n_beads / longest
 
 
 def _check_models_and_launch(config: Mapping) -> list[str]:
@@ -367,128 +332,3 @@ def check_config(config: Mapping) -> None:
 
     check_ablation(config)
     check_bounds(config, check_config)  # chain.pipeline.config_bounds: bounds needing 2 keys
-
-
-@dataclass(frozen=True)
-class ExperimentPart:
-    """One chain of the experiment: where its traces come from.
-
-    Attributes
-    ----------
-    name : str
-        Series name (the ``model`` column; chains of one name are pooled in the fits).
-    n_beads : int
-        N.
-    sensor_beads : tuple of int
-        Sensor beads, S1 first.
-    folder : str or None
-        The measured dataset folder; None for the virtual experiment (its folder is a
-        pipeline output).
-    files : tuple of str
-        ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
-    virtual : bool
-        Whether the traces come from the virtual experiment (a model, not data),
-        including a measured-format dataset that it wrote.
-    """
-
-    name: str
-    n_beads: int
-    sensor_beads: tuple[int, ...]
-    folder: str | None = None
-    files: tuple[str, ...] = ()
-    virtual: bool = True
-
-
-def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[ExperimentPart]:
-    """The chains of a config's experiment, reading measured datasets' metadata.
-
-    Parameters
-    ----------
-    config : mapping
-        A config that passed :func:`check_config`.
-    root : path
-        Folder that relative dataset paths start from (the working directory).
-
-    Returns
-    -------
-    list of ExperimentPart
-        Empty with ``experiment.source: none``; one per configured chain for the
-        virtual experiment; one per dataset for measured datasets.
-
-    Raises
-    ------
-    ConfigError
-        Naming ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong
-        (the loader's message, with file and line), its name is not usable in file
-        names, or two datasets give the same name and N.
-    """
-    # Imported here: chain.apparatus.measured reads files; check_config does not need it.
-    from chain.apparatus.measured import MeasuredDataError, read_metadata
-
-    experiment = config.get("experiment", {})
-    source = experiment.get("source", "none")
-    name = experiment.get("name")
-    if source == "virtual":
-        return [
-            ExperimentPart(name or VIRTUAL_SERIES, int(c["N"]), tuple(c["sensors"]))
-            for c in config["chains"]
-        ]
-    if source != "measured":
-        return []
-    parts: list[ExperimentPart] = []
-    seen: dict[tuple[str, int], int] = {}
-    for i, folder in enumerate(experiment.get("datasets", [])):
-        path = ["experiment", "datasets", i]
-        where = Path(folder) if Path(folder).is_absolute() else Path(root) / folder
-        try:
-            meta = read_metadata(where)
-        except MeasuredDataError as error:
-            _fail(path, f"{error}")
-        series = name or meta.name or where.resolve().name
-        if not SERIES_NAME.match(series):
-            _fail(
-                path,
-                f"dataset name {series!r} (metadata name, else folder name) is not usable "
-                "in file names; allowed: letters, digits, '_', '-', starting with a "
-                "letter; set experiment.name",
-            )
-        key = (series, meta.n_beads)
-        if key in seen:
-            _fail(
-                path,
-                f"gives the series {series!r} with N = {meta.n_beads} again (as "
-                f"experiment.datasets[{seen[key]}]); allowed: one dataset per name and N",
-            )
-        seen[key] = i
-        parts.append(
-            ExperimentPart(
-                name=series,
-                n_beads=meta.n_beads,
-                sensor_beads=tuple(meta.sensor_beads),
-                folder=str(folder),
-                files=(
-                    str(Path(folder) / "metadata.yaml"),
-                    *(str(Path(folder) / shot.file) for shot in meta.shots),
-                ),
-                virtual=VIRTUAL_LABEL in (meta.description or ""),
-            )
-        )
-    return parts
-
-
-def experiment_label(parts: Sequence[ExperimentPart]) -> str:
-    """How figures and the summary name the experiment series.
-
-    ``"virtual experiment (model)"`` for the virtual experiment run by the pipeline;
-    ``"measured (<names>)"`` for measured datasets, and ``"virtual experiment (model):
-    <names>"`` for a measured-format dataset that the virtual experiment wrote (it is
-    still not data).
-    """
-    if not parts:
-        return "experiment"
-    if all(part.folder is None for part in parts):
-        return VIRTUAL_LABEL
-    names = ", ".join(dict.fromkeys(part.name for part in parts))
-    if all(part.virtual for part in parts):
-        return f"{VIRTUAL_LABEL}: {names}"
-    return f"measured ({names})"

@@ -32,7 +32,7 @@ import copy
 from collections.abc import Callable, Mapping
 
 from chain.analysis.pulses import DEFAULT_MIN_SNR, MIN_FIT_SAMPLES
-from chain.errors import key_label
+from chain.errors import ConfigError, key_label
 from chain.physics.materials import get_material
 from chain.physics.theory import (
     LAUNCH_VELOCITY_RATIO,
@@ -46,7 +46,7 @@ from chain.pipeline.mechanisms import (
     sweep_settings,
     viscous_name,
 )
-from chain.pipeline.virtual_config import ConfigError, virtual_experiment_settings
+from chain.pipeline.virtual_config import virtual_experiment
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
 #: the slowest pulse. 1, not chain.pipeline.config.DURATION_MARGIN (1.2, which also
@@ -244,14 +244,10 @@ def _striker_ratio(config: Mapping, virtual: Mapping) -> float:
 
 
 def _check_virtual(config: Mapping) -> None:
-    # Imported here: chain.apparatus.virtual pulls in the simulation core.
-    from chain.apparatus.virtual import VirtualExperiment
-
     virtual = config["experiment"]["virtual"]
     base = ["experiment", "virtual"]
     entry = config["chains"][0]
-    settings = virtual_experiment_settings(config, entry["N"], entry["sensors"])
-    speeds = VirtualExperiment.from_dict(settings).nominal_speeds
+    speeds = virtual_experiment(config, entry["N"], entry["sensors"]).nominal_speeds
     ratio = LAUNCH_VELOCITY_RATIO * _striker_ratio(config, virtual)
     _check_resolution(
         config,

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import yaml
 
-from chain.pipeline.config import ConfigError
+from chain.errors import ConfigError
 
 
 class _StrictLoader(yaml.SafeLoader):

@@ -1,8 +1,13 @@
-"""The measured datasets a config uses, checked before any job runs.
+"""The experiment's parts (chains and their datasets) and labels, and the measured
+datasets a config uses, checked before any job runs.
+
+:func:`experiment_parts` gives the chains of the experiment (one per configured chain
+for the virtual experiment, one per dataset folder for measured data, read from its
+``metadata.yaml``) and :func:`experiment_label` how figures and the summary name them.
 
 :func:`check_experiment_datasets` runs :func:`chain.apparatus.dataset_check.check_dataset`
 on every dataset folder of ``experiment.datasets`` when the pipeline builds its DAG, and
-stops with one :class:`~chain.pipeline.config.ConfigError` that lists every problem of
+stops with one :class:`~chain.errors.ConfigError` that lists every problem of
 every dataset (up to a limit each), one console line per problem: file, line, column,
 what was expected. Shots with a dead or saturated channel stop the run too, unless
 ``experiment.bad_channels: skip``; then :func:`skipped_shot_rows` gives the rows that
@@ -13,18 +18,151 @@ so the summary counts them among the rejected shots.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
 from chain.analysis.selection import SELECTION_COLUMNS, SKIPPED_REASON
 from chain.apparatus.dataset_check import DatasetCheck, check_dataset
-from chain.apparatus.measured import MeasuredDataError, usable_shots
-from chain.pipeline.config import ConfigError, ExperimentPart
+from chain.apparatus.measured import MeasuredDataError, read_metadata, usable_shots
+from chain.errors import ConfigError
+from chain.errors import key_label as key_name
+from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
 
 #: Where the pipeline keeps the verdicts of the dataset check (by file content).
 DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / "dataset-check"
+
+#: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
+SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+
+
+def _fail(path, message: str):
+    raise ConfigError(f"config key {key_name(path)!r}: {message}")
+
+
+@dataclass(frozen=True)
+class ExperimentPart:
+    """One chain of the experiment: where its traces come from.
+
+    Attributes
+    ----------
+    name : str
+        Series name (the ``model`` column; chains of one name are pooled in the fits).
+    n_beads : int
+        N.
+    sensor_beads : tuple of int
+        Sensor beads, S1 first.
+    folder : str or None
+        The measured dataset folder; None for the virtual experiment (its folder is a
+        pipeline output).
+    files : tuple of str
+        ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
+    virtual : bool
+        Whether the traces come from the virtual experiment (a model, not data),
+        including a measured-format dataset that it wrote.
+    """
+
+    name: str
+    n_beads: int
+    sensor_beads: tuple[int, ...]
+    folder: str | None = None
+    files: tuple[str, ...] = ()
+    virtual: bool = True
+
+
+def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[ExperimentPart]:
+    """The chains of a config's experiment, reading measured datasets' metadata.
+
+    Parameters
+    ----------
+    config : mapping
+        A config that passed :func:`chain.pipeline.config.check_config`.
+    root : path
+        Folder that relative dataset paths start from (the working directory).
+
+    Returns
+    -------
+    list of ExperimentPart
+        Empty with ``experiment.source: none``; one per configured chain for the
+        virtual experiment; one per dataset for measured datasets.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong
+        (the loader's message, with file and line), its name is not usable in file
+        names, or two datasets give the same name and N.
+    """
+    experiment = config.get("experiment", {})
+    source = experiment.get("source", "none")
+    name = experiment.get("name")
+    if source == "virtual":
+        return [
+            ExperimentPart(name or VIRTUAL_SERIES, int(c["N"]), tuple(c["sensors"]))
+            for c in config["chains"]
+        ]
+    if source != "measured":
+        return []
+    parts: list[ExperimentPart] = []
+    seen: dict[tuple[str, int], int] = {}
+    for i, folder in enumerate(experiment.get("datasets", [])):
+        path = ["experiment", "datasets", i]
+        where = Path(folder) if Path(folder).is_absolute() else Path(root) / folder
+        try:
+            meta = read_metadata(where)
+        except MeasuredDataError as error:
+            _fail(path, f"{error}")
+        series = name or meta.name or where.resolve().name
+        if not SERIES_NAME.match(series):
+            _fail(
+                path,
+                f"dataset name {series!r} (metadata name, else folder name) is not usable "
+                "in file names; allowed: letters, digits, '_', '-', starting with a "
+                "letter; set experiment.name",
+            )
+        key = (series, meta.n_beads)
+        if key in seen:
+            _fail(
+                path,
+                f"gives the series {series!r} with N = {meta.n_beads} again (as "
+                f"experiment.datasets[{seen[key]}]); allowed: one dataset per name and N",
+            )
+        seen[key] = i
+        parts.append(
+            ExperimentPart(
+                name=series,
+                n_beads=meta.n_beads,
+                sensor_beads=tuple(meta.sensor_beads),
+                folder=str(folder),
+                files=(
+                    str(Path(folder) / "metadata.yaml"),
+                    *(str(Path(folder) / shot.file) for shot in meta.shots),
+                ),
+                virtual=VIRTUAL_LABEL in (meta.description or ""),
+            )
+        )
+    return parts
+
+
+def experiment_label(parts: Sequence[ExperimentPart]) -> str:
+    """How figures and the summary name the experiment series.
+
+    ``"virtual experiment (model)"`` for the virtual experiment run by the pipeline;
+    ``"measured (<names>)"`` for measured datasets, and ``"virtual experiment (model):
+    <names>"`` for a measured-format dataset that the virtual experiment wrote (it is
+    still not data).
+    """
+    if not parts:
+        return "experiment"
+    if all(part.folder is None for part in parts):
+        return VIRTUAL_LABEL
+    names = ", ".join(dict.fromkeys(part.name for part in parts))
+    if all(part.virtual for part in parts):
+        return f"{VIRTUAL_LABEL}: {names}"
+    return f"measured ({names})"
 
 
 def bad_channel_policy(config: Mapping) -> str:
@@ -45,7 +183,7 @@ def check_experiment_datasets(
     config : mapping
         A config that passed :func:`chain.pipeline.config.check_config`.
     parts : sequence of ExperimentPart
-        :func:`chain.pipeline.config.experiment_parts` of it (virtual parts, whose
+        :func:`experiment_parts` of it (virtual parts, whose
         datasets are pipeline outputs, are skipped).
     root : path
         Folder that relative dataset paths start from.

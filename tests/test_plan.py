@@ -1,0 +1,132 @@
+"""The run plan (chain.pipeline.plan.RunPlan): each fact of a run derived once from the
+checked config, and a simulate job's inputs as a cache key (issue 31, issue 33)."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from snakemake.utils import validate
+
+from chain.pipeline.config import check_config
+from chain.pipeline.jobs import JOB_KEYS, chain_of
+from chain.pipeline.plan import RunPlan
+
+ROOT = Path(__file__).resolve().parents[1]
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+
+def checked(config: dict) -> dict:
+    """A config as the Snakefile has it: validated (defaults filled in), checked."""
+    config = copy.deepcopy(config)
+    validate(config, str(SCHEMA))
+    check_config(config)
+    return config
+
+
+@pytest.fixture(scope="module")
+def paper() -> dict:
+    return checked(yaml.safe_load((ROOT / "config.yaml").read_text()))
+
+
+@pytest.fixture(scope="module")
+def plan(paper) -> RunPlan:
+    return RunPlan(paper, root=str(ROOT))
+
+
+def test_job_inputs_change_with_the_physics_only(paper, plan):
+    job = plan.simulate_job("viscoelastic", 26)
+    assert tuple(job) == JOB_KEYS
+    assert json.loads(json.dumps(job)) == job  # a cache can hash its JSON text
+    # An analysis or figure key does not change what the simulation computes...
+    analysis = copy.deepcopy(paper)
+    analysis["analysis"]["main_estimator"] = "peak"
+    analysis["figures"]["representative_force_N"] = 100.0
+    assert RunPlan(analysis).simulate_job("viscoelastic", 26) == job
+    # ...a contact law does, and only for the model it belongs to.
+    eta = copy.deepcopy(paper)
+    eta["models"][1]["eta_s"] = 1.0e-6
+    assert RunPlan(eta).simulate_job("viscoelastic", 26) != job
+    assert RunPlan(eta).simulate_job("elastic", 26) == plan.simulate_job("elastic", 26)
+
+
+def test_launch_speeds_are_the_configured_geometric_series(plan):
+    speeds = np.array(plan.speeds)
+    assert len(speeds) == 12 and speeds[0] == 0.021 and speeds[-1] == 1.0
+    assert np.diff(np.log(speeds)) == pytest.approx(np.log(1.0 / 0.021) / 11, rel=1e-9)
+    # Every simulation of the run, the C-sensitivity study's too, launches at them.
+    assert plan.simulate_job("elastic", 25)["speeds_m_s"] == list(plan.speeds)
+    assert plan.c_sensitivity["speeds_m_s"] == list(plan.speeds)
+    assert all(job["speeds_m_s"] == list(plan.speeds) for job in plan.c_sensitivity_jobs())
+
+
+def test_the_chain_follows_the_readout(paper):
+    felt = RunPlan(paper).chain("viscoelastic", 25)
+    assert felt.n_particles == 25 and not felt.is_conservative
+    sensor = copy.deepcopy(paper)
+    sensor["simulation"]["readout"] = "sensor"
+    split = RunPlan(checked(sensor)).chain("viscoelastic", 25)
+    # Each of the two sensor beads is split in two halves joined by the sensor spring.
+    assert split.n_particles == 27
+    assert chain_of(RunPlan(checked(sensor)).simulate_job("elastic", 25)).is_conservative
+
+
+def test_conservative_models_and_the_spacetime_model(paper, plan):
+    assert plan.conservative == ("elastic",)
+    assert plan.spacetime_model == "elastic"
+    dissipative = copy.deepcopy(paper)
+    dissipative["models"] = [{"name": "viscoelastic", "eta_s": 0.58e-6}]
+    dissipative["figures"]["traces_model"] = "viscoelastic"
+    other = RunPlan(dissipative)
+    assert other.conservative == () and other.spacetime_model == "viscoelastic"
+
+
+def test_durations_and_long_chains(paper, plan):
+    assert plan.duration(25) == paper["simulation"]["duration_s"]
+    # A long chain runs in proportion to N (longest configured chain: 26 beads).
+    assert plan.duration(120) == pytest.approx(2.6e-3 * 120 / 26)
+    assert plan.tracked_chains == (25, 26, 120, 121)
+    long = plan.simulate_job("elastic", 121)
+    assert long["sensors"] == [] and long["duration_s"] == plan.duration(121)
+    with pytest.raises(KeyError, match="N = 30"):
+        plan.simulate_job("elastic", 30)
+
+
+def test_the_virtual_experiment_takes_the_config_names(paper, plan):
+    settings = plan.virtual_experiment(26)
+    virtual = paper["experiment"]["virtual"]
+    for key, value in virtual.items():
+        got = getattr(settings, key)
+        assert got == (tuple(value) if isinstance(value, list) else value), key
+    assert settings.seed == paper["seed"] + 26 and settings.sensor_beads == (10, 17)
+    assert settings.striker_radius == paper["setup"]["striker_radius_m"]
+    assert json.loads(json.dumps(plan.virtual_settings(26))) == plan.virtual_settings(26)
+
+
+def test_targets_follow_the_experiment_and_the_studies(paper, plan):
+    assert plan.experiment_label == "virtual experiment (model)"
+    assert f"{plan.tables}/ablation_exponent.csv" in plan.targets()
+    assert "fig2_experiment_traces" in plan.figure_names()
+    none = copy.deepcopy(paper)
+    none["experiment"]["source"] = "none"
+    none["mechanism_study"] = False
+    bare = RunPlan(none)
+    assert bare.experiment == () and bare.experiment_label == "experiment"
+    assert "fig2_experiment_traces" not in bare.figure_names()
+    assert bare.optional_table("ablation_exponent") == []
+    assert bare.candidates(full=True) == {} and not bare.lammps
+    assert not any("ssw_mechanisms" in path for path in bare.targets())
+
+
+def test_the_plan_is_frozen_and_keeps_its_own_config(paper):
+    config = copy.deepcopy(paper)
+    plan = RunPlan(config)
+    config["launch"]["count"] = 3
+    assert len(plan.speeds) == 12 and plan.config["launch"]["count"] == 12
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        plan.speeds = ()

@@ -1,0 +1,44 @@
+# Input functions of the experiment's rules (experiment.smk) and of Fig. 2, from the
+# plan's experiment parts.
+
+
+def raw_dataset(n):
+    """Folder of the virtual experiment's dataset of the chain of n beads."""
+    return f"{OUT}/experiment/raw/N{n}"
+
+
+def experiment_datasets():
+    """Each experiment dataset: its folder, series name, N and trace file."""
+    return [
+        {
+            "folder": raw_dataset(part.n_beads) if part.folder is None else part.folder,
+            "name": part.name,
+            "N": part.n_beads,
+            "traces": trace_file("experiment", part.name, part.n_beads),
+        }
+        for part in PLAN.experiment
+    ]
+
+
+def experiment_dataset_files():
+    """What loading the datasets depends on: the virtual experiment's folders, or the
+    measured datasets' metadata.yaml and shot files (editing one reloads them)."""
+    return [
+        path
+        for part in PLAN.experiment
+        for path in ([raw_dataset(part.n_beads)] if part.folder is None else part.files)
+    ]
+
+
+def virtual_settings(wildcards):
+    """The VirtualExperiment fields of one chain (plain values: a changed one reruns
+    the job; RunPlan.virtual_settings)."""
+    return PLAN.virtual_settings(int(wildcards.N))
+
+
+def fig2_trace_files(wildcards):
+    """Experiment chains shown in Fig. 2: those in figures.traces_N when it is set
+    (all of them if it names none), else all."""
+    chosen = config["figures"]["traces_N"]
+    shown = [part for part in EXPERIMENT_PARTS if not chosen or part[2] in chosen]
+    return [trace_file(*part) for part in shown or EXPERIMENT_PARTS]
