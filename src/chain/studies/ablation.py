@@ -9,7 +9,7 @@ protocol and its own range of amplitudes. A variant changes some of them
 settings of each chain). :func:`run_variant` runs the virtual experiment of every
 chain with those settings (the same seed as the run, so a variant with no overrides
 reproduces the run's experiment) and fits Delta = C F_m^(-1/6) and a free power law
-(:func:`chain.analysis.delays.delay_fit_table`); replicates repeat it with other seeds
+as every series is fitted (:mod:`chain.analysis.recipe`); replicates repeat it with other seeds
 to show the spread a seed gives (:mod:`chain.studies.ablation_table`).
 
 This module reads no config and knows no Snakemake.
@@ -23,9 +23,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from chain.analysis.delays import delay_fit_table, delay_table
 from chain.analysis.pulse_rows import pulse_table
-from chain.analysis.rows import flag_unusable
+from chain.analysis.recipe import fit_pulses
 from chain.analysis.selection import select_shots
 from chain.apparatus.measured import load_dataset
 from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
@@ -39,7 +38,8 @@ def run_variant(
     series: str = VIRTUAL_SERIES,
 ) -> pd.DataFrame:
     """Run the virtual experiment on each chain, analyse it as the pipeline does, and
-    fit |Delta| against F_m (:func:`run_variant_shots`, then :func:`variant_delay_fits`).
+    fit |Delta| against F_m (:func:`run_variant_shots`, then
+    :func:`chain.analysis.recipe.fit_pulses`).
 
     Parameters
     ----------
@@ -59,7 +59,7 @@ def run_variant(
         :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
     """
     _, pulses, selection = run_variant_shots(settings_per_chain, tolerance, estimators, series)
-    return variant_delay_fits(pulses, selection)
+    return fit_pulses(pulses, selection)
 
 
 def run_variant_shots(
@@ -97,10 +97,3 @@ def run_variant_shots(
     if tolerance is not None:
         selection = select_shots(table, tolerance, estimator=estimators[0])
     return traces, table, selection
-
-
-def variant_delay_fits(pulses: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
-    """|Delta| = C F_m^(-1/6) and the free power law, pooled and per chain, of the pulses
-    of :func:`run_variant_shots` (:func:`chain.analysis.delays.delay_fit_table` rows)."""
-    delays = delay_table(pulses, selection=selection)
-    return delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))

@@ -13,9 +13,8 @@ from collections.abc import Sequence
 
 import pandas as pd
 
-from chain.analysis.delays import delay_fit_table, delay_table
 from chain.analysis.pulse_rows import pulse_table
-from chain.analysis.rows import flag_unusable
+from chain.analysis.recipe import fit_pulses
 from chain.analysis.ssw import ssw_fit_table, ssw_table
 
 
@@ -32,15 +31,13 @@ def analyse_traces(traces: pd.DataFrame, estimator: str) -> tuple[pd.DataFrame, 
     Returns
     -------
     delay_fits : DataFrame
-        :func:`chain.analysis.delays.delay_fit_table` rows (per N and pooled).
+        :func:`chain.analysis.recipe.fit_pulses` rows (per N and pooled).
     ssw_fits : DataFrame
         :func:`chain.analysis.ssw.ssw_fit_table` rows of the S2 readings (SSW behind LSTW).
     """
     pulses = pulse_table(traces, estimators=(estimator,))
-    delays = delay_table(pulses)
-    fits = delay_fit_table(flag_unusable(delays, ["F_m_N", "delay_us"], "delay rows"))
     ssw = ssw_table(traces, pulses, estimator=estimator)
-    return fits, ssw_fit_table(ssw[ssw["sensor"] == "S2"])
+    return fit_pulses(pulses), ssw_fit_table(ssw[ssw["sensor"] == "S2"])
 
 
 def variant_ssw_fits(
