@@ -18,7 +18,7 @@ from chain.apparatus.shots import shot_time_step, simulate_shots
 from chain.physics.materials import get_material
 from chain.physics.model import uniform_chain
 from chain.studies.mechanism_fits import analyse_traces
-from chain.studies.mechanism_settings import granular_chain, lammps_options
+from chain.studies.mechanism_settings import granular_chain
 
 #: Columns of ``tables/lammps_check.csv``.
 CHECK_COLUMNS = (
@@ -109,7 +109,7 @@ def run_lammps_check(config: Mapping, estimator: str) -> pd.DataFrame:
     estimator : str
         Pulse estimator of the C fits.
     """
-    options = lammps_options(config)
+    options = config["lammps"]
     speeds = options["check_speeds_m_s"]
     material = get_material(config["material"])
     rows = []

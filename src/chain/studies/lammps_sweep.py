@@ -13,7 +13,6 @@ from chain.apparatus.lammps_shots import lammps_shots
 from chain.studies.mechanism_fits import analyse_traces
 from chain.studies.mechanism_settings import (
     granular_chain,
-    lammps_options,
     sweep_settings,
     viscous_settings,
 )
@@ -45,7 +44,7 @@ def run_sweep_setting(
         ``traces``, ``runs`` (:func:`chain.apparatus.lammps_shots.lammps_shots`),
         ``delay_fits`` and ``ssw_fits`` (:func:`analyse_traces`).
     """
-    options = lammps_options(config)
+    options = config["lammps"]
     viscous = viscous_settings(config, full=True)
     if name in viscous:
         chain = granular_chain(config, n_beads, eta=0.0, track=True, viscous_damping=viscous[name])

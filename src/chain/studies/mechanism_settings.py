@@ -17,34 +17,6 @@ from chain.physics.lammps_engine import GranularChain
 from chain.physics.materials import get_material
 from chain.studies.ablation_table import overrides_text
 
-#: Defaults of the ``lammps`` config section (as in the schema).
-DEFAULTS = {
-    "time_step_s": 2.5e-8,
-    "record_interval_s": 1e-6,
-    "duration_s": 2.6e-3,
-    "check_speeds_m_s": [0.021, 0.0459, 0.1, 0.215],
-}
-SWEEP_DEFAULTS = {
-    "launch_speeds_m_s": [0.021, 0.053, 0.13],
-    "eta_s": 0.58e-6,
-    "gravity_m_s2": 9.81,
-    "track_friction": [0.0, 0.1, 0.3, 0.5],
-    "bead_friction": [0.0, 0.1, 0.3],
-    "default_settings": [[0.0, 0.0], [0.3, 0.0], [0.3, 0.3], [0.5, 0.3]],
-    "viscous_N_s_per_m": [2.0, 10.0, 30.0],
-    "default_viscous_N_s_per_m": [10.0],
-}
-
-
-def lammps_options(config: Mapping) -> dict:
-    """The ``lammps`` section of a schema-valid config with its defaults filled in;
-    ``sweep`` likewise."""
-    section = dict(config.get("lammps") or {})
-    options = {key: section.get(key, value) for key, value in DEFAULTS.items()}
-    sweep = dict(section.get("sweep") or {})
-    options["sweep"] = {key: sweep.get(key, value) for key, value in SWEEP_DEFAULTS.items()}
-    return options
-
 
 def setting_name(track_friction: float, bead_friction: float) -> str:
     """File-safe name of a (mu_t, mu_b) setting, e.g. ``mut030-mub010``."""
@@ -58,8 +30,16 @@ def setting_label(track_friction: float, bead_friction: float) -> str:
 
 def sweep_settings(config: Mapping, full: bool) -> dict[str, tuple[float, float]]:
     """Name -> (mu_t, mu_b) of the sweep: the default run's pairs (``full`` False), or
-    those and the whole grid; the frictionless (0, 0) first, always."""
-    sweep = lammps_options(config)["sweep"]
+    those and the whole grid; the frictionless (0, 0) first, always.
+
+    Parameters
+    ----------
+    config : mapping
+        A schema-valid config (``lammps.sweep`` is read).
+    full : bool
+        The whole mu_t x mu_b grid too (target ``mechanisms``).
+    """
+    sweep = config["lammps"]["sweep"]
     pairs = [(t, b) for t, b in sweep["default_settings"]]
     if full:
         pairs += [(t, b) for t in sweep["track_friction"] for b in sweep["bead_friction"]]
@@ -74,8 +54,16 @@ def viscous_name(gamma: float) -> str:
 
 def viscous_settings(config: Mapping, full: bool) -> dict[str, float]:
     """Name -> gamma (N s/m) of the viscous inter-bead settings: the default run's or,
-    with ``full``, those and the full list."""
-    sweep = lammps_options(config)["sweep"]
+    with ``full``, those and the full list.
+
+    Parameters
+    ----------
+    config : mapping
+        A schema-valid config (``lammps.sweep`` is read).
+    full : bool
+        The full list too (target ``mechanisms``).
+    """
+    sweep = config["lammps"]["sweep"]
     values = list(sweep["default_viscous_N_s_per_m"])
     if full:
         values += list(sweep["viscous_N_s_per_m"])
@@ -120,7 +108,7 @@ def granular_chain(
         bead_friction=float(bead_friction),
         track_friction=float(track_friction),
         track=bool(track),
-        gravity=float(lammps_options(config)["sweep"]["gravity_m_s2"]),
+        gravity=float(config["lammps"]["sweep"]["gravity_m_s2"]),
         viscous_damping=float(viscous_damping),
     )
 
