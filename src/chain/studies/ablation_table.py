@@ -42,8 +42,8 @@ def ablation_table(fits: Mapping[str, pd.DataFrame], overrides: Mapping[str, str
     Parameters
     ----------
     fits : mapping
-        Variant name -> its fits (:func:`run_variant` rows with a ``replicate``
-        column; replicate 0 is the run's seed).
+        Variant name -> its fits (:func:`chain.studies.ablation.run_variant` rows with a
+        ``replicate`` column; replicate 0 is the run's seed).
     overrides : mapping
         Variant name -> its overrides as text (for the ``overrides`` column).
 
