@@ -1,5 +1,6 @@
 """Ablation of the virtual experiment: the switches that turn an apparatus ingredient
-into the paper's simulation, and the config-driven variants (chain.pipeline.ablation)."""
+into the paper's simulation, and the config-driven variants
+(chain.pipeline.ablation_config, chain.studies.ablation_table)."""
 
 import copy
 import dataclasses
@@ -16,14 +17,14 @@ from chain.apparatus.virtual import VirtualExperiment, plan_shots, simulate_virt
 from chain.errors import ConfigError, ParameterError
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
-from chain.pipeline.ablation import (
-    ablation_table,
+from chain.pipeline.ablation_config import (
     ablation_variants,
     check_ablation,
     variant_settings,
     variant_tolerance,
 )
 from chain.pipeline.virtual_config import virtual_experiment_settings
+from chain.studies.ablation_table import ablation_table
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -155,6 +156,18 @@ def test_variants_map_config_keys(paper):
     check_ablation(paper)
 
 
+def with_variants(paper: dict, *variants: dict) -> dict:
+    """The paper's config with ``ablation.variants``, schema defaults filled in; each
+    variant's ``set`` goes in after validation, so that one the schema refuses reaches
+    check_ablation (its second line of defence) all the same."""
+    config = copy.deepcopy(paper)
+    config["ablation"] = {"variants": [{"name": v["name"]} for v in variants]}
+    validate(config, str(SCHEMA))
+    for entry, variant in zip(config["ablation"]["variants"], variants, strict=True):
+        entry["set"] = variant.get("set", {})
+    return config
+
+
 @pytest.mark.parametrize(
     ("variant", "fragment"),
     [
@@ -164,8 +177,7 @@ def test_variants_map_config_keys(paper):
     ],
 )
 def test_bad_variants_name_the_key(paper, variant, fragment):
-    config = copy.deepcopy(paper)
-    config["ablation"] = {"variants": [variant]}
+    config = with_variants(paper, variant)
     with pytest.raises(ConfigError) as error:
         check_ablation(config)
     assert fragment in str(error.value)
@@ -173,8 +185,7 @@ def test_bad_variants_name_the_key(paper, variant, fragment):
 
 
 def test_duplicate_variant_names_are_refused(paper):
-    config = copy.deepcopy(paper)
-    config["ablation"] = {"variants": [{"name": "a"}, {"name": "a"}]}
+    config = with_variants(paper, {"name": "a"}, {"name": "a"})
     with pytest.raises(ConfigError, match=r"ablation.variants\[1\].name"):
         check_ablation(config)
 

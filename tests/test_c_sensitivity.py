@@ -1,4 +1,4 @@
-"""C against our choices (chain.pipeline.c_sensitivity), its summary entries
+"""C against our choices (chain.studies.c_sensitivity), its summary entries
 (chain.report.spread) and its figure (chain.report.fig_c_sensitivity)."""
 
 from pathlib import Path
@@ -11,14 +11,14 @@ from snakemake.utils import validate
 
 from chain.apparatus.shots import simulate_shots
 from chain.physics.model import uniform_chain
-from chain.pipeline.c_sensitivity import (
+from chain.pipeline.plan import launch_speeds
+from chain.report.fig_c_sensitivity import fig_c_sensitivity
+from chain.report.spread import ablation_summary, c_spread_summary, spread_markdown_rows
+from chain.studies.c_sensitivity import (
     c_sensitivity_table,
     sensitivity_plan,
     shifted_pairs,
 )
-from chain.pipeline.plan import launch_speeds
-from chain.report.fig_c_sensitivity import fig_c_sensitivity
-from chain.report.spread import ablation_summary, c_spread_summary, spread_markdown_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 

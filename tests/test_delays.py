@@ -10,6 +10,8 @@ import pytest
 
 from chain.analysis.delays import DELAY_COLUMNS, DELAY_FIT_COLUMNS, delay_fit_table, delay_table
 from chain.analysis.pulse_rows import pulse_table
+from chain.analysis.recipe import fit_delays, fit_pulses
+from chain.errors import ParameterError
 from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
@@ -189,3 +191,28 @@ def test_delay_fit_table_small_groups_give_nan():
     assert fits.loc[25, "n_points"] == 2
     assert math.isfinite(fits.loc[25, "C_us_N16"])
     assert math.isnan(fits.loc[25, "exponent"])
+
+
+def test_recipe_leaves_unusable_rows_out_where_the_fit_would_refuse_them():
+    """The recipe's row policy (chain.analysis.recipe.fit_delays): an ``ok`` row with a
+    NaN delay or force is left out of the fits, which alone refuse it."""
+    forces = np.geomspace(10.0, 1000.0, 5)
+    clean = synthetic_delay_rows(40.0, forces, 25)
+    broken = clean.iloc[:2].assign(delay_us=[np.nan, -30.0], F_m_N=[100.0, np.inf])
+    delays = pd.concat([clean, broken], ignore_index=True)
+    with pytest.raises(ParameterError, match="finite"):
+        delay_fit_table(delays)
+    fits = fit_delays(delays)
+    pd.testing.assert_frame_equal(fits, delay_fit_table(clean), check_exact=True)
+    assert fits.set_index("N").loc[25, "n_points"] == 10
+    assert delays["ok"].all()  # the caller's table is left as it was
+
+
+def test_recipe_from_pulses_is_the_delay_table_and_its_fits_bit_for_bit():
+    """pulses -> delays -> fits (fit_pulses) gives what the steps one by one give, with
+    and without a shot selection."""
+    traces = synthetic_traces(-6e-6, -4e-6, noise=3.0, seed=2, n_references=2)
+    pulses = pulse_table(traces, estimators=("fit_full", "peak"))
+    for selection in (None, pd.DataFrame({"shot": [0], "kept": [True]})):
+        expected = delay_fit_table(delay_table(pulses, selection=selection))
+        pd.testing.assert_frame_equal(fit_pulses(pulses, selection), expected, check_exact=True)

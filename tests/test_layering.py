@@ -3,7 +3,9 @@ downhill only, so that physics can be read without tables, the analysis without
 figures, and the report without an integrator.
 
     pipeline, cli          (config keys, results/, the command line)
-    report                 -> analysis, physics.theory/materials
+    studies | report       (side by side, no arrow between them)
+      studies              -> physics, apparatus, analysis (simulate and analyse in-process)
+      report               -> analysis, physics.theory/materials
     apparatus | analysis   (side by side, no arrow between them)
     physics                -> errors only
     errors, atomic, csv_text, traces, labels, _lazy
@@ -35,8 +37,11 @@ ALLOWED = {
     "analysis": BOTTOM | {"chain.analysis"},
     "report": BOTTOM
     | {"chain.report", "chain.analysis", "chain.physics.theory", "chain.physics.materials"},
-    "pipeline": BOTTOM | {"chain.pipeline", "chain.physics", "chain.apparatus", "chain.analysis"},
-    "cli": BOTTOM | {"chain.physics", "chain.apparatus", "chain.analysis", "chain.pipeline"},
+    "studies": BOTTOM | {"chain.studies", "chain.physics", "chain.apparatus", "chain.analysis"},
+    "pipeline": BOTTOM
+    | {"chain.pipeline", "chain.studies", "chain.physics", "chain.apparatus", "chain.analysis"},
+    "cli": BOTTOM
+    | {"chain.physics", "chain.apparatus", "chain.analysis", "chain.studies", "chain.pipeline"},
 }
 
 #: Wing -> third-party packages it must not import.
@@ -46,6 +51,7 @@ FORBIDDEN = {
     "apparatus": {"matplotlib"},
     "analysis": {"matplotlib", "numba"},
     "report": {"numba"},
+    "studies": {"matplotlib"},
     "pipeline": {"matplotlib"},
     "cli": set(),
 }
@@ -120,6 +126,9 @@ def test_the_check_catches_an_uphill_import(tmp_path):
     assert allowed("chain.report.fig4_delay_vs_force", "chain.analysis.rows")
     assert not allowed("chain.report.fig4_delay_vs_force", "chain.physics.integrator")
     assert not allowed("chain.analysis.ssw", "chain.apparatus.virtual")
+    assert allowed("chain.pipeline.config", "chain.studies.ablation")
+    assert not allowed("chain.studies.ablation", "chain.pipeline.virtual_config")
+    assert not allowed("chain.studies.sweep", "chain.report.fig_c_vs_N")
 
 
 def test_scripts_import_concrete_modules():

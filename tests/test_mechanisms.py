@@ -7,10 +7,13 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
+from snakemake.utils import validate
 
 from chain.apparatus.virtual import VirtualExperiment, plan_shots
 from chain.apparatus.virtual_shots import apparatus_chain, chain_draws, rest_displacement
@@ -18,13 +21,11 @@ from chain.errors import ParameterError
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
-from chain.pipeline.mechanisms import (
-    candidate_variants,
-    mechanism_rows,
-    setting_name,
-    sweep_settings,
-)
 from chain.report.mechanisms import candidate_sentence, friction_sentence
+from chain.studies.mechanism_settings import candidate_variants, setting_name, sweep_settings
+from chain.studies.mechanism_table import mechanism_rows
+
+ROOT = Path(__file__).resolve().parents[1]
 
 TINY = VirtualExperiment(
     n_beads=10,
@@ -106,7 +107,9 @@ def test_bad_candidate_settings_are_named(change):
 
 
 def test_sweep_always_starts_from_the_frictionless_setting():
-    config = {"lammps": {"sweep": {"default_settings": [[0.3, 0.1]]}}}
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    config["lammps"] = {"sweep": {"default_settings": [[0.3, 0.1]]}}
+    validate(config, str(ROOT / "workflow" / "schemas" / "config.schema.yaml"))
     assert list(sweep_settings(config, full=False)) == ["mut000-mub000", "mut030-mub010"]
     full = sweep_settings(config, full=True)
     assert len(full) == 12 and next(iter(full)) == setting_name(0, 0)

@@ -9,7 +9,10 @@ Its wings, each importing only the ones below it (``tests/test_layering.py``):
 * :mod:`chain.apparatus`: simulated shots, acquisition, virtual experiment, measured data;
 * :mod:`chain.analysis`: pulses, selection, delays, SSW, regression, row hygiene;
 * :mod:`chain.report`: figures and the summary;
-* :mod:`chain.pipeline`: config checks and the headline check (the only config-aware code).
+* :mod:`chain.studies`: ablation, C sensitivity, sweep and mechanism studies, simulated
+  and analysed in-process;
+* :mod:`chain.pipeline`: the workflow glue, config checks and the headline check (with
+  the studies, the only config-aware code).
 
 The public names below are imported on first use, so ``import chain`` is cheap.
 """

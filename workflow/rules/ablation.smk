@@ -1,6 +1,6 @@
 # Ablation of the virtual experiment (issue 13, item 6; a MODEL, not data): one job
 # per variant of config `ablation.variants` reruns the virtual experiment of every
-# chain with that variant's settings (chain.pipeline.ablation), analyses it as the
+# chain with that variant's settings (chain.studies.ablation), analyses it as the
 # pipeline analyses the experiment (pulses, 5 % selection, delays) and fits
 # |Delta| = C F_m^(-1/6) and a free exponent; ablation_table gathers the variants.
 # Variants marked default_run are in the default run (tables/ablation_exponent.csv);

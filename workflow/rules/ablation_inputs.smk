@@ -1,6 +1,6 @@
 # Input functions and settings of the ablation rules (ablation.smk), from the plan.
 
-from chain.pipeline.ablation import overrides_text
+from chain.studies.ablation_table import overrides_text
 
 
 wildcard_constraints:

@@ -114,7 +114,7 @@ rule ssw_fits:
 
 # How much C depends on our choices (issue 13, item 7): estimator, eta, sensor pair,
 # amplitude range, one at a time from the headline choice, on shots simulated anew
-# (every sensor bead of every pair recorded; chain.pipeline.c_sensitivity).
+# (every sensor bead of every pair recorded; chain.studies.c_sensitivity).
 rule c_sensitivity:
     input:
         code("c_sensitivity"),

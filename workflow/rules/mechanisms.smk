@@ -2,7 +2,7 @@
 # (chain.physics.lammps_engine): the frictionless 1D cross-check against our kernel
 # (tables/lammps_check.csv), and the friction/rotation sweep (floor track, gravity,
 # track friction mu_t, bead-bead friction mu_b, rolling and twisting resistance), one
-# job per (setting, chain), analysed as every series (chain.pipeline.mechanisms), and
+# job per (setting, chain), analysed as every series (chain.studies.lammps_sweep), and
 # a viscous inter-bead force instead of Kuwabara-Kono on the frictionless track:
 # tables/ssw_mechanisms.csv and its figure. The default run runs
 # lammps.sweep.default_settings (~30 s on 2 cores); the whole mu_t x mu_b grid:

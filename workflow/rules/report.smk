@@ -1,6 +1,6 @@
 # The summary beside the paper's numbers, and the HTML report.
 
-from chain.pipeline.mechanisms import FRICTION_MECHANISM, REFERENCE_MECHANISM
+from chain.studies.mechanism_table import FRICTION_MECHANISM, REFERENCE_MECHANISM
 
 
 rule summary:

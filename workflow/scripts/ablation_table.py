@@ -1,11 +1,11 @@
 """tables/ablation_exponent.csv from the fits of every ablation variant
-(chain.pipeline.ablation.ablation_table)."""
+(chain.studies.ablation_table.ablation_table)."""
 
 import pandas as pd
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.ablation import ablation_table
+from chain.studies.ablation_table import ablation_table
 
 log = start(snakemake)
 p = snakemake.params

@@ -1,12 +1,13 @@
 """One ablation variant of the virtual experiment (a model), all its replicates: delay
-fits (chain.pipeline.ablation) and SSW fits at S2 (chain.pipeline.mechanisms)."""
+fits (chain.studies.ablation) and SSW fits at S2 (chain.studies.mechanism_fits)."""
 
 import pandas as pd
 from _logging import start
 
+from chain.analysis.recipe import fit_pulses
 from chain.atomic import write_csv_atomic
-from chain.pipeline.ablation import run_variant_shots, variant_delay_fits
-from chain.pipeline.mechanisms import variant_ssw_fits
+from chain.studies.ablation import run_variant_shots
+from chain.studies.mechanism_fits import variant_ssw_fits
 
 log = start(snakemake)
 p = snakemake.params
@@ -15,7 +16,7 @@ for replicate, chains in enumerate(p.settings):
     traces, pulses, selection = run_variant_shots(
         chains, p.tolerance, p.estimators, series=p.series
     )
-    fits = variant_delay_fits(pulses, selection)
+    fits = fit_pulses(pulses, selection)
     ssw_fits = variant_ssw_fits(traces, pulses, selection, p.estimators[0])
     seeds = [c["seed"] for c in chains]
     pooled = fits[fits["N"].astype(str) == "pooled"].iloc[0]

@@ -1,12 +1,12 @@
 """tables/c_sensitivity.csv: C and the free exponent per choice of estimator, eta,
-sensor pair and amplitude range (chain.pipeline.c_sensitivity), on simulated shots."""
+sensor pair and amplitude range (chain.studies.c_sensitivity), on simulated shots."""
 
 from _logging import start
 
 from chain.apparatus.shots import simulate_shots
 from chain.atomic import write_csv_atomic
-from chain.pipeline.c_sensitivity import c_sensitivity_table
 from chain.pipeline.jobs import chain_of, simulation_kwargs
+from chain.studies.c_sensitivity import c_sensitivity_table
 
 log = start(snakemake)
 p = snakemake.params

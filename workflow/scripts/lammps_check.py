@@ -1,9 +1,9 @@
-"""LAMMPS against our kernel in the frictionless 1D limit (chain.pipeline.mechanisms)."""
+"""LAMMPS against our kernel in the frictionless 1D limit (chain.studies.lammps_check)."""
 
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.mechanisms import run_lammps_check
+from chain.studies.lammps_check import run_lammps_check
 
 log = start(snakemake)
 table = run_lammps_check(snakemake.params.config, snakemake.params.estimator)

@@ -1,10 +1,10 @@
 """One friction/rotation setting on one chain, run by LAMMPS and analysed
-(chain.pipeline.mechanisms.run_sweep_setting)."""
+(chain.studies.lammps_sweep.run_sweep_setting)."""
 
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.mechanisms import run_sweep_setting
+from chain.studies.lammps_sweep import run_sweep_setting
 from chain.traces import write_traces
 
 log = start(snakemake)

@@ -1,12 +1,12 @@
 """tables/ssw_mechanisms.csv: SSW/F_m at S2 and C per mechanism and setting: the LAMMPS
 friction/rotation sweep and the virtual experiment's candidates
-(chain.pipeline.mechanisms)."""
+(chain.studies.mechanism_table)."""
 
 import pandas as pd
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.mechanisms import (
+from chain.studies.mechanism_table import (
     FRICTION_MECHANISM,
     VISCOUS_MECHANISM,
     candidate_rows,

@@ -1,11 +1,11 @@
 """Sweep table: C and SSW slope per model and chain, with each model's eta
-(chain.pipeline.sweep.sweep_table)."""
+(chain.studies.sweep.sweep_table)."""
 
 import pandas as pd
 from _logging import start
 
 from chain.atomic import write_csv_atomic
-from chain.pipeline.sweep import sweep_table
+from chain.studies.sweep import sweep_table
 
 log = start(snakemake)
 table = sweep_table(

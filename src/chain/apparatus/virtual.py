@@ -24,7 +24,7 @@ data whose truth is known:
 * acquisition (:mod:`chain.apparatus.acquisition`): additive Gaussian noise, sampling every
   ``sampling_interval_s``, volts through the sensitivity, ADC quantisation.
 
-Switches for ablation studies (:mod:`chain.pipeline.ablation`) turn single ingredients
+Switches for ablation studies (:mod:`chain.studies.ablation`) turn single ingredients
 into the paper's simulation: ``readout="felt"`` reads plain beads instead of split
 sensor beads, ``launch="bead"`` launches the end beads instead of strikers, and
 ``reference_speed_mismatch`` sets the reference shots' speed spread apart.

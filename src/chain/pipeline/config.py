@@ -52,6 +52,7 @@ from chain.physics.theory import (
     force_from_bead_velocity,
     pulse_passing_time,
 )
+from chain.pipeline.ablation_config import check_ablation
 from chain.pipeline.virtual_config import virtual_experiment
 
 #: The duration must be this many times the time the slowest pulse needs to pass the
@@ -326,8 +327,6 @@ def check_config(config: Mapping) -> None:
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
-    # Imported here: the ablation module pulls in the analysis (pandas, the delay fits).
-    from chain.pipeline.ablation import check_ablation
     from chain.pipeline.config_bounds import check_bounds
 
     check_ablation(config)

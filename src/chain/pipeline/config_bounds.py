@@ -40,13 +40,12 @@ from chain.physics.theory import (
     pulse_half_width,
     pulse_passing_time,
 )
-from chain.pipeline.mechanisms import (
-    lammps_options,
+from chain.pipeline.virtual_config import virtual_experiment
+from chain.studies.mechanism_settings import (
     setting_name,
     sweep_settings,
     viscous_name,
 )
-from chain.pipeline.virtual_config import virtual_experiment
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
 #: the slowest pulse. 1, not chain.pipeline.config.DURATION_MARGIN (1.2, which also
@@ -272,7 +271,7 @@ def _check_virtual(config: Mapping) -> None:
 
 
 def _check_lammps(config: Mapping) -> None:
-    options = lammps_options(config)
+    options = config["lammps"]
     step, record = options["time_step_s"], options["record_interval_s"]
     _check_multiple(["lammps", "record_interval_s"], record, step, "lammps.time_step_s")
     speeds = [*options["check_speeds_m_s"], *options["sweep"]["launch_speeds_m_s"]]
@@ -291,7 +290,7 @@ def _check_lammps(config: Mapping) -> None:
 
 
 def _check_setting_names(config: Mapping) -> None:
-    sweep = lammps_options(config)["sweep"]
+    sweep = config["lammps"]["sweep"]
     base = ["lammps", "sweep"]
     for key in ("track_friction", "bead_friction", "default_settings"):
         names: dict[str, object] = {}

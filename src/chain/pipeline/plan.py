@@ -28,18 +28,18 @@ from chain.apparatus.virtual_settings import VirtualExperiment
 from chain.labels import VIRTUAL_SERIES
 from chain.physics.lammps_engine import lammps_available
 from chain.physics.model import ChainModel
-from chain.pipeline.ablation import ablation_variants, variant_settings, variant_tolerance
-from chain.pipeline.c_sensitivity import sensitivity_plan, shifted_pairs
+from chain.pipeline.ablation_config import ablation_variants, variant_settings, variant_tolerance
 from chain.pipeline.datasets import ExperimentPart, experiment_label, experiment_parts
 from chain.pipeline.jobs import chain_of
-from chain.pipeline.mechanisms import (
+from chain.pipeline.resources import JobNeeds, simulation_needs, simulation_threads
+from chain.pipeline.virtual_config import virtual_experiment_settings
+from chain.studies.c_sensitivity import sensitivity_plan, shifted_pairs
+from chain.studies.mechanism_settings import (
     CANDIDATE_REFERENCE,
     candidate_variants,
     sweep_settings,
     viscous_settings,
 )
-from chain.pipeline.resources import JobNeeds, simulation_needs, simulation_threads
-from chain.pipeline.virtual_config import virtual_experiment_settings
 
 #: The contract tables of every run (tables/<name>.csv), in order.
 TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed c_sensitivity".split())
@@ -104,7 +104,7 @@ class RunPlan:
     traces_n : tuple of int
         Chains of Figs. 2 and 3 and the space-time figure (``figures.traces_N``, or all).
     ablation : dict
-        Variant name -> variant (:func:`chain.pipeline.ablation.ablation_variants`).
+        Variant name -> variant (:func:`chain.pipeline.ablation_config.ablation_variants`).
     """
 
     config: Mapping
@@ -277,7 +277,7 @@ class RunPlan:
     @cached_property
     def c_sensitivity(self) -> dict:
         """The C-sensitivity study's choices
-        (:func:`chain.pipeline.c_sensitivity.sensitivity_plan`, the run's speeds)."""
+        (:func:`chain.studies.c_sensitivity.sensitivity_plan`, the run's speeds)."""
         return sensitivity_plan(self.config, list(self.speeds))
 
     def c_sensitivity_jobs(self) -> list[dict]:

@@ -3,7 +3,7 @@
 the run's material, radius, striker and seed, and the chain.
 
 Its own module so that both :mod:`chain.pipeline.config` (the checks) and
-:mod:`chain.pipeline.ablation` (the variants) use it without importing each other.
+:mod:`chain.pipeline.ablation_config` (the variants) use it without importing each other.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ def fig_c_sensitivity(table: pd.DataFrame, *, ax=None) -> Figure:
     Parameters
     ----------
     table : DataFrame
-        ``c_sensitivity.csv`` (:func:`chain.pipeline.c_sensitivity.c_sensitivity_table`).
+        ``c_sensitivity.csv`` (:func:`chain.studies.c_sensitivity.c_sensitivity_table`).
     ax : Axes, optional
         Draw here instead of on a new figure.
     """

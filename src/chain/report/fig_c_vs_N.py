@@ -1,6 +1,6 @@
 """Sweep figure: the crossing-delay constant C against the number of beads N.
 
-Drawn from ``tables/sweep.csv`` (:func:`chain.pipeline.sweep.sweep_table`), one
+Drawn from ``tables/sweep.csv`` (:func:`chain.studies.sweep.sweep_table`), one
 colour per contact model (eta), even chains (the waves meet at a contact) filled, odd
 chains (at a bead) open, error bars one standard error; the paper's measured C
 (N = 25, 26) as a grey band for scale. Its companion, the SSW slope against N, is

@@ -32,7 +32,7 @@ def fig_ssw_mechanisms(table: pd.DataFrame, *, ax=None) -> Figure:
     Parameters
     ----------
     table : DataFrame
-        ``ssw_mechanisms.csv`` (:func:`chain.pipeline.mechanisms.mechanism_rows`).
+        ``ssw_mechanisms.csv`` (:func:`chain.studies.mechanism_table.mechanism_rows`).
     ax : Axes, optional
         Draw here instead of on a new figure.
     """

@@ -1,8 +1,8 @@
 """Summary entries of the ablation of the virtual experiment and of the spread of C
 (``summary.json`` keys ``ablation`` and ``c_spread``, and their ``summary.md`` rows).
 
-The numbers come from ``tables/ablation_exponent.csv`` (chain.pipeline.ablation) and
-``tables/c_sensitivity.csv`` (chain.pipeline.c_sensitivity); nothing is computed here
+The numbers come from ``tables/ablation_exponent.csv`` (chain.studies.ablation_table) and
+``tables/c_sensitivity.csv`` (chain.studies.c_sensitivity); nothing is computed here
 but the selection of rows and the wording.
 """
 

@@ -12,7 +12,7 @@ a time and C and the free exponent are refitted, per chain and pooled:
 
 The shots are simulated with :func:`chain.apparatus.shots.simulate_shots` (once per eta
 and chain, every sensor bead recorded) and analysed with
-:func:`chain.analysis.pulse_rows.pulse_table` and :mod:`chain.analysis.delays`, as in the
+:func:`chain.analysis.pulse_rows.pulse_table` and :mod:`chain.analysis.recipe`, as in the
 paper run. This module maps config keys; it reads no file and knows no Snakemake.
 """
 
@@ -22,8 +22,8 @@ from collections.abc import Mapping, Sequence
 
 import pandas as pd
 
-from chain.analysis.delays import delay_fit_table, delay_table
 from chain.analysis.pulse_rows import pulse_table
+from chain.analysis.recipe import fit_pulses
 from chain.traces import META_COLUMNS, sensor_column
 
 #: Sensor shifts (beads, positive towards the collision point) besides the configured pair.
@@ -95,7 +95,7 @@ def _fits(pulses: pd.DataFrame, estimator: str, amplitudes=None) -> pd.DataFrame
     rows = pulses[pulses["estimator"] == estimator]
     if amplitudes is not None:
         rows = rows[rows["amplitude"].isin(amplitudes)]
-    return delay_fit_table(delay_table(rows))
+    return fit_pulses(rows)
 
 
 def pair_pulses(traces: Mapping[int, pd.DataFrame], pairs, estimators) -> pd.DataFrame:

@@ -1,0 +1,99 @@
+"""Ablation of the virtual experiment: rerun it with one ingredient changed at a time.
+
+The virtual experiment (:mod:`chain.apparatus.virtual`, a MODEL of the apparatus) is
+the paper's simulation plus apparatus ingredients: strikers instead of a launched end
+bead, split sensor beads instead of a point readout, Kuwabara-Kono dissipation, noise
+and a digitiser, shot-to-shot speed mismatch and launch jitter, the 5 % acceptance
+protocol and its own range of amplitudes. A variant changes some of them
+(:mod:`chain.pipeline.ablation_config` maps the config's ``ablation.variants`` to the
+settings of each chain). :func:`run_variant` runs the virtual experiment of every
+chain with those settings (the same seed as the run, so a variant with no overrides
+reproduces the run's experiment) and fits Delta = C F_m^(-1/6) and a free power law
+as every series is fitted (:mod:`chain.analysis.recipe`); replicates repeat it with other seeds
+to show the spread a seed gives (:mod:`chain.studies.ablation_table`).
+
+This module reads no config and knows no Snakemake.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from chain.analysis.pulse_rows import pulse_table
+from chain.analysis.recipe import fit_pulses
+from chain.analysis.selection import select_shots
+from chain.apparatus.measured import load_dataset
+from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
+from chain.labels import VIRTUAL_SERIES
+
+
+def run_variant(
+    settings_per_chain: Sequence[Mapping],
+    tolerance: float | None,
+    estimators: Sequence[str] = ("fit_full",),
+    series: str = VIRTUAL_SERIES,
+) -> pd.DataFrame:
+    """Run the virtual experiment on each chain, analyse it as the pipeline does, and
+    fit |Delta| against F_m (:func:`run_variant_shots`, then
+    :func:`chain.analysis.recipe.fit_pulses`).
+
+    Parameters
+    ----------
+    settings_per_chain : sequence of mapping
+        VirtualExperiment fields, one mapping per chain
+        (:func:`chain.pipeline.ablation_config.variant_settings`).
+    tolerance : float or None
+        Acceptance tolerance (relative amplitude mismatch); None keeps every shot.
+    estimators : sequence of str
+        Pulse estimators (:data:`chain.analysis.pulses.ESTIMATORS`).
+    series : str
+        Series name (the ``model`` column).
+
+    Returns
+    -------
+    DataFrame
+        :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
+    """
+    _, pulses, selection = run_variant_shots(settings_per_chain, tolerance, estimators, series)
+    return fit_pulses(pulses, selection)
+
+
+def run_variant_shots(
+    settings_per_chain: Sequence[Mapping],
+    tolerance: float | None,
+    estimators: Sequence[str] = ("fit_full",),
+    series: str = VIRTUAL_SERIES,
+) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
+    """Run the virtual experiment on each chain and fit its pulses and select its shots
+    as the pipeline does (parameters as :func:`run_variant`).
+
+    The shots go through the measured-data path (written in the measured-trace format
+    to a temporary folder and loaded back), pulses are fitted per chain and collisions
+    are selected with ``tolerance``.
+
+    Returns
+    -------
+    traces : list of DataFrame
+        The trace table of each chain.
+    pulses : DataFrame
+        Their pulse rows (:func:`chain.analysis.pulse_rows.pulse_table`).
+    selection : DataFrame or None
+        The shot selection (None with ``tolerance`` None).
+    """
+    pulses, traces = [], []
+    with tempfile.TemporaryDirectory(prefix="ablation.") as folder:
+        for i, fields in enumerate(settings_per_chain):
+            settings = VirtualExperiment.from_dict(fields)
+            dataset = Path(folder) / f"chain{i}"
+            run_virtual_experiment(settings, dataset, series)
+            traces.append(load_dataset(dataset, name=series))
+            pulses.append(pulse_table(traces[-1], estimators=tuple(estimators)))
+    table = pd.concat(pulses, ignore_index=True)
+    selection = None
+    if tolerance is not None:
+        selection = select_shots(table, tolerance, estimator=estimators[0])
+    return traces, table, selection

@@ -1,0 +1,70 @@
+"""What the mechanism study measures of a series: C of Delta = C F_m^(-1/6) and the
+SSW/F_m slope at S2 (the SSW behind the LSTW), analysed as every other series.
+
+The pulses, delays and their fits follow the pipeline's recipe
+(:mod:`chain.analysis.recipe`); the SSW are read at S2 with
+:func:`chain.analysis.ssw.ssw_table` and fitted with
+:func:`chain.analysis.ssw.ssw_fit_table`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import pandas as pd
+
+from chain.analysis.pulse_rows import pulse_table
+from chain.analysis.recipe import fit_pulses
+from chain.analysis.ssw import ssw_fit_table, ssw_table
+
+
+def analyse_traces(traces: pd.DataFrame, estimator: str) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """C and the SSW slope at S2 of one trace table, as the pipeline analyses any series.
+
+    Parameters
+    ----------
+    traces : DataFrame
+        A trace table (collision and reference shots per amplitude).
+    estimator : str
+        Pulse estimator (:data:`chain.analysis.pulses.ESTIMATORS`).
+
+    Returns
+    -------
+    delay_fits : DataFrame
+        :func:`chain.analysis.recipe.fit_pulses` rows (per N and pooled).
+    ssw_fits : DataFrame
+        :func:`chain.analysis.ssw.ssw_fit_table` rows of the S2 readings (SSW behind LSTW).
+    """
+    pulses = pulse_table(traces, estimators=(estimator,))
+    ssw = ssw_table(traces, pulses, estimator=estimator)
+    return fit_pulses(pulses), ssw_fit_table(ssw[ssw["sensor"] == "S2"])
+
+
+def variant_ssw_fits(
+    traces: Sequence[pd.DataFrame],
+    pulses: pd.DataFrame,
+    selection: pd.DataFrame | None,
+    estimator: str,
+) -> pd.DataFrame:
+    """SSW = slope x F_m at S2 (behind LSTW) of an ablation variant's shots
+    (:func:`chain.studies.ablation.run_variant_shots`), the same shot selection.
+
+    Parameters
+    ----------
+    traces : sequence of DataFrame
+        The trace table of each chain.
+    pulses : DataFrame
+        Their pulse rows.
+    selection : DataFrame or None
+        The shot selection; None keeps every shot.
+    estimator : str
+        Pulse estimator.
+    """
+    ssw = pd.concat(
+        [
+            ssw_table(t, pulses[pulses["N"] == t["N"].iloc[0]], selection, estimator=estimator)
+            for t in traces
+        ],
+        ignore_index=True,
+    )
+    return ssw_fit_table(ssw[ssw["sensor"] == "S2"])
