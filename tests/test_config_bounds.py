@@ -1,6 +1,6 @@
 """Config bounds (issue 32, item 3): every value outside a key's range stops the run
 before any job, naming the key; the values at the bounds pass; docs/config_bounds.md is
-the table the schema and chain.pipeline.config_bounds.RULES give.
+the table the schema and chain.pipeline.config_bounds_table.RULES give.
 
 Each case changes the tiny config (tests/configs/tiny.yaml on config.yaml) and runs the
 checks the Snakefile runs (schema, then check_config); one case goes through Snakemake.
@@ -19,7 +19,8 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
 from chain.pipeline.config import ConfigError, check_config
-from chain.pipeline.config_bounds import RULES, bounds_table, variant_config
+from chain.pipeline.config_bounds import variant_config
+from chain.pipeline.config_bounds_table import CHOICE, RULES, bounds_table, table_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -30,6 +31,13 @@ def tiny() -> dict:
     config = yaml.safe_load((ROOT / "config.yaml").read_text())
     update_config(config, yaml.safe_load((ROOT / "tests" / "configs" / "tiny.yaml").read_text()))
     return config
+
+
+@pytest.fixture(scope="module")
+def plain(tiny) -> dict:
+    """The tiny config without the ablation variants (each variant is checked with its
+    own settings, so a run bound would be reached through a variant first)."""
+    return {**copy.deepcopy(tiny), "ablation": {"variants": []}}
 
 
 def outcome(config: dict, overlay: dict) -> str | None:
@@ -124,10 +132,52 @@ BOUNDS = {
         {"sampling_interval_s": 3e-5},
         {"sampling_interval_s": 1e-5},
     ),
+    "sensor S1 2 beads left of the collision point": (
+        ("chains", 0, "sensors", 0),
+        [{"N": 16, "sensors": [7, 12]}, {"N": 17, "sensors": [5, 13]}],
+        [{"N": 16, "sensors": [6, 12]}, {"N": 17, "sensors": [5, 13]}],
+    ),
+    "sensor S2 2 beads right of the collision point": (
+        ("chains", 0, "sensors", 1),
+        [{"N": 16, "sensors": [5, 10]}, {"N": 17, "sensors": [5, 13]}],
+        [{"N": 16, "sensors": [5, 11]}, {"N": 17, "sensors": [5, 13]}],
+    ),
+    # N = 5 ([1, 5]) leaves the launch jitter no room: N = 6 with the virtual experiment.
+    "N >= 5": (("chains", 0, "N"), [{"N": 4, "sensors": [1, 4]}], [{"N": 6, "sensors": [1, 6]}]),
+    "seed <= 2^62": (("seed",), 2**62 + 1, 2**62),
+    "model name <= 100 characters": (
+        ("models", 0, "name"),
+        [{"name": "e" * 101, "eta_s": 0.0}, {"name": "viscoelastic", "eta_s": 0.58e-6}],
+        [{"name": "e" * 100, "eta_s": 0.0}, {"name": "viscoelastic", "eta_s": 0.58e-6}],
+    ),
+    "long chains <= 1 s": (("long_chains", "duration_s"), 1.01, 1.0),
+    "lammps duration <= 1 s": (("lammps", "duration_s"), 1.01, 1.0),
+    "tolerance > 0": (("experiment", "tolerance"), 0.0, 0.05),
+    "tolerance keeps 2 shots (planned speeds)": (("experiment", "tolerance"), 0.008, 0.0082),
+    "drag leaves the smallest pulse detectable": (
+        ("experiment", "virtual", "drag_rate_per_s"),
+        2900.0,
+        2800.0,
+    ),
+    "ADC step under the smallest pulse": (
+        ("experiment", "virtual", "adc_range_V"),
+        {"adc_range_V": 90.0},
+        {"adc_range_V": 88.0},
+    ),
+    "sensor spring resolved by the given step": (
+        ("experiment", "virtual", "sensor_stiffness_N_per_m"),
+        4.6e9,
+        4.5e9,
+    ),
+    "right delay keeps the collision between the sensors": (
+        ("experiment", "virtual", "right_delay_s"),
+        {"right_delay_s": 1.9e-4, "timing_jitter_s": 0.0},
+        {"right_delay_s": 1.8e-4, "timing_jitter_s": 0.0},
+    ),
     "noise below the smallest pulse": (
         ("experiment", "virtual", "noise_N"),
-        {"noise_N": 4.0, "adc_bits": None},
         {"noise_N": 3.9, "adc_bits": None},
+        {"noise_N": 3.8, "adc_bits": None},
     ),
 }
 
@@ -135,26 +185,51 @@ BOUNDS = {
 def overlay_of(path: tuple, value) -> dict:
     """The overlay that sets ``value``: a dict value sets several keys of the section."""
     keys = tuple(p for p in path if not isinstance(p, int))
+    if isinstance(value, list) and value and isinstance(value[0], dict):
+        return {keys[0]: value}  # the whole list of chains or models
     if isinstance(value, dict):
         return nest(keys[:-1], value)
     return nest(keys, value)
 
 
 @pytest.mark.parametrize(("path", "outside", "inside"), BOUNDS.values(), ids=BOUNDS)
-def test_value_outside_is_stopped_naming_the_key(tiny, path, outside, inside):
-    message = outcome(tiny, overlay_of(path, outside))
+def test_value_outside_is_stopped_naming_the_key(plain, path, outside, inside):
+    message = outcome(plain, overlay_of(path, outside))
     assert message is not None, "accepted"
     assert named(message, path), message
-    assert outcome(tiny, overlay_of(path, inside)) is None
+    assert outcome(plain, overlay_of(path, inside)) is None
 
 
-def test_default_run_variant_is_checked_with_its_settings(tiny):
-    variants = [{"name": "slow", "default_run": True, "set": {"duration_s": 2e-4}}]
+def test_every_variant_is_checked_with_its_settings(tiny):
+    """`snakemake ablation` runs every variant, not only those of the default run."""
+    variants = [{"name": "slow", "set": {"duration_s": 2e-4}}]
     message = outcome(tiny, {"ablation": {"variants": variants}})
     assert "config key 'ablation.variants[0].set' (variant 'slow')" in message
     assert "experiment.virtual.duration_s" in message
-    variants[0]["default_run"] = False  # only `snakemake ablation` runs it
+    variants[0]["set"]["duration_s"] = 1.5e-3
     assert outcome(tiny, {"ablation": {"variants": variants}}) is None
+
+
+def test_bead_launch_duration_is_the_launched_beads(tiny):
+    """launch: bead launches the end beads at V0 (no 4 mm striker, whose wave is ~30 x
+    smaller): its duration is the simulation's, not the strikers'."""
+    bead = {"launch": "bead", "impact_speeds_m_s": [0.021, 0.05, 0.1]}
+    variants = [{"name": "bead", "set": {**bead, "duration_s": 1.25e-3}}]
+    message = outcome(tiny, {"ablation": {"variants": variants}})
+    assert "(variant 'bead')" in message and "experiment.virtual.duration_s" in message
+    variants[0]["set"]["duration_s"] = 1.35e-3
+    assert outcome(tiny, {"ablation": {"variants": variants}}) is None
+
+
+def test_heavy_striker_bounces_less(tiny):
+    """A striker of the beads' mass hands on its momentum m_s V0 and stops (an elastic
+    bounce gives 2 m_s m / (m_s + m) V0): the paper's heavy_striker variant reads
+    ~1 V at 0.13 m/s, under the 2 V of its ADC."""
+    heavy = {"striker_radius_m": 0.013, "impact_speeds_m_s": [0.021, 0.05, 0.13]}
+    assert outcome(tiny, {"ablation": {"variants": [{"name": "h", "set": heavy}]}}) is None
+    heavy["impact_speeds_m_s"] = [0.05, 0.1, 0.3]
+    message = outcome(tiny, {"ablation": {"variants": [{"name": "h", "set": heavy}]}})
+    assert "experiment.virtual.adc_range_V" in message
 
 
 def test_variant_config_applies_the_overrides(tiny):
@@ -163,7 +238,7 @@ def test_variant_config_applies_the_overrides(tiny):
     derived = variant_config(config, {"striker_radius_m": 0.013, "noise_N": 0.0, "tolerance": None})
     assert derived["setup"]["striker_radius_m"] == 0.013
     assert derived["experiment"]["virtual"]["noise_N"] == 0.0
-    assert derived["experiment"]["tolerance"] == config["experiment"]["tolerance"]
+    assert derived["experiment"]["tolerance"] is None  # no selection: nothing to bound
     assert derived["ablation"]["variants"] == [] and config["ablation"]["variants"]
 
 
@@ -176,6 +251,16 @@ def test_table_is_generated_from_schema_and_rules():
     )
     keys = {line.split("`")[1] for line in table.splitlines() if line.startswith("| `")}
     assert set(RULES) <= keys, sorted(set(RULES) - keys)
+
+
+def test_every_key_has_a_largest_value_or_a_reason():
+    """Issue 32 item 3: a smallest and a largest usable value per key; where the schema
+    has no largest, RULES says what bounds it or why nothing does."""
+    rows = table_rows(yaml.safe_load(SCHEMA.read_text()))
+    blank = [key for key, _, kind, _, upper, rule in rows if not upper and not rule]
+    assert blank == [], blank
+    choices = {key: upper for key, _, kind, _, upper, _ in rows if kind == "boolean"}
+    assert set(choices.values()) == {CHOICE}
 
 
 def test_snakemake_dry_run_refuses_before_any_job(tmp_path):

@@ -262,10 +262,10 @@ SMALL = "tests/data/virtual_small"
 #: item of the issue -> (change, key named, what the message says is allowed / wrong).
 BAD_CONFIGS = {
     # -- types, ranges and unknown keys (the schema) --
-    "N >= 2": (
-        setter("chains", 0, "N", value=1),
+    "N >= 5": (
+        setter("chains", 0, "N", value=4),
         on("chains", 0, "N"),
-        "less than the minimum of 2",
+        "less than the minimum of 5",
     ),
     "N an integer": (
         setter("chains", 1, "N", value="26"),
@@ -494,9 +494,9 @@ BAD_CONFIGS = {
         "allowed: <= the sampling interval, or null",
     ),
     "virtual: duration for the waves": (
-        setter("experiment", "virtual", "duration_s", value=1.8e-3),
+        setter("experiment", "virtual", "duration_s", value=1.5e-3),
         key("experiment.virtual.duration_s"),
-        "0.0018 s is too short: the slowest wave (strikers of 4 mm",
+        "0.0015 s is too short: the slowest wave (striker at 0.4 m/s",
     ),
     "virtual: ADC range": (
         setter("experiment", "virtual", "adc_range_V", value=0.5),
