@@ -30,7 +30,7 @@ commands:
              C_bal with the exact Hertz contact time, wave speed (Eq. 5)
   check      check a pipeline run: every contract file present, headline numbers
              (C, exponents, SSW slopes, C_bal, energy drift) within tolerance of a
-             committed reference
+             committed reference; warns when its packages differ from the lock
 
 Beads are numbered 1..N as in the paper. Units: SI (m, s, m/s, N).
 Example:
@@ -159,7 +159,8 @@ def _add_check(commands) -> None:
         help="check a run against the results contract and a reference",
         description="Check results/<run_name>: contract files and columns, and the headline "
         "numbers of summary.json against a reference file within its tolerances. "
-        "Exit status 1 lists every failure.",
+        "Exit status 1 lists every failure. Packages the run had at other versions than "
+        "the lock (requirements/py3XX.lock) are named in a warning.",
     )
     check.add_argument("run_folder", help="results/<run_name>")
     check.add_argument(
@@ -200,6 +201,7 @@ def _check(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from chain.pipeline import headline
+    from chain.pipeline.provenance import lock_warnings
 
     folder = Path(args.run_folder)
     summary_path = folder / "summary.json"
@@ -217,6 +219,9 @@ def _check(args: argparse.Namespace) -> int:
     failures += headline.compare_with_reference(headline.headline_numbers(summary), reference)
     for failure in failures:
         print(f"FAIL {failure}")
+    # Versions other than the lock's may move a number; they warn, never fail.
+    for warning in lock_warnings(summary.get("provenance")):
+        print(f"WARNING {warning}")
     checked = len(reference["values"])
     if failures:
         print(f"{len(failures)} problem(s); {checked} headline numbers in the reference")
