@@ -57,3 +57,38 @@ def test_steps_are_the_readme_commands_and_keep_the_run():
     for upload in uploads:
         assert "results/paper/article.pdf" in upload["with"]["path"]
         assert upload["with"]["name"] in readme  # the README says how to get it
+
+
+def _installs(job: dict) -> list[str]:
+    return [s["run"].strip() for s in job["steps"] if s.get("run", "").startswith("pip install")]
+
+
+def _python(job: dict) -> str:
+    (version,) = [s["with"]["python-version"] for s in job["steps"]
+                  if s.get("uses", "").startswith("actions/setup-python")]  # fmt: skip
+    return version
+
+
+def test_runs_install_their_pythons_lock_and_a_weekly_job_the_newest():
+    """Issue 32: the runs install the lock of their Python with hashes, then the project
+    without dependencies; one scheduled job installs the ranges' newest versions (no lock)
+    and runs the paper run, the number check and the tests."""
+    workflow = yaml.safe_load(WORKFLOWS[0].read_text(encoding="utf-8"))
+    locked, unlocked = {}, {}
+    for name, job in workflow["jobs"].items():
+        installs = _installs(job)
+        (locked if any("-r requirements/" in c for c in installs) else unlocked)[name] = job
+    assert locked and len(unlocked) == 1
+    for name, job in locked.items():
+        lock = f"requirements/py{_python(job).replace('.', '')}.lock"
+        assert (ROOT / lock).is_file(), f"{name}: no {lock} for Python {_python(job)}"
+        assert _installs(job) == [f"pip install --require-hashes -r {lock}",
+                                  "pip install --no-deps -e ."], name  # fmt: skip
+    (newest,) = unlocked.values()
+    assert "schedule" in newest["if"] and "push" not in newest["if"]
+    assert _installs(newest)[0] == 'pip install -e ".[test]"'  # the quick start
+    commands = [s["run"].strip() for s in newest["steps"] if "run" in s]
+    assert {"snakemake --cores 2", "python -m pytest"} <= set(commands)
+    assert any(c.startswith("hertzchain check") for c in commands)
+    schedule = workflow[True]["schedule"] if True in workflow else workflow["on"]["schedule"]
+    assert schedule  # YAML 1.1 reads the key `on` as True

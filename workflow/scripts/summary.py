@@ -45,6 +45,7 @@ if snakemake.input.get("mechanisms"):
         friction=p.friction_mechanism,
         reference=p.reference_mechanism,
     )
+summary["provenance"] = p.provenance  # issue 32: versions, and the lock's
 write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])

@@ -359,6 +359,8 @@ def uniform_chain(
     wall_kappa = contact_stiffness(material, radius, material, math.inf)
     left_striker = right_striker = None
     if striker_radius is not None:
+        # Named here: Striker.sphere's own check would call it "radius", the beads' name.
+        striker_radius = require_positive("striker_radius", striker_radius)
         striker = Striker.sphere(striker_radius, material, radius, material)
         left_striker = striker if strikers in ("both", "left") else None
         right_striker = striker if strikers in ("both", "right") else None

@@ -1,9 +1,15 @@
-"""Which run produced an article: commit, commit date, config hash and package versions.
+"""Which run produced an article: commit, commit date, config hash and package versions,
+and whether those versions are the lock's.
 
 Everything here is a function of the inputs, never of the clock, so the same checkout and
 configuration give the same article bytes: the date is the commit's (UTC), not today's.
 Outside a git checkout (a copied workflow, an unpacked archive) or without git, the
 commit and date say so; uncommitted changes are named as such, not hidden.
+
+The locks (``requirements/py3XX.lock``, one per Python, written by
+``requirements/lock.sh``) pin every package of the project and its extras; a run records
+every installed version and which of them differ from its Python's lock, so a number
+that moved can be traced to the release that moved it.
 """
 
 from __future__ import annotations
@@ -12,14 +18,23 @@ import hashlib
 import json
 import os
 import platform
+import re
 import subprocess
+import sys
 from collections.abc import Iterable, Mapping
 from importlib import metadata
+from pathlib import Path
 
 #: Packages whose versions the article states (distribution names).
 PACKAGES = ("hertzchain", "numpy", "scipy", "pandas", "numba", "matplotlib", "snakemake", "typst")
 
 NOT_GIT = "not a git checkout"
+NOT_INSTALLED = "not installed"
+
+#: Folder of the locks in the checkout, one file per Python: py311.lock, py312.lock, ...
+LOCK_FOLDER = "requirements"
+#: A pin of a lock file: ``name==version`` at the start of a line.
+_PIN = re.compile(r"^([A-Za-z0-9][A-Za-z0-9._-]*)==([^\s;\\]+)", re.MULTILINE)
 
 
 def config_hash(config: Mapping) -> str:
@@ -66,13 +81,113 @@ def package_versions(names: Iterable[str] = PACKAGES) -> dict[str, str]:
         try:
             versions[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
-            versions[name] = "not installed"
+            versions[name] = NOT_INSTALLED
     return versions
 
 
+def normalized_name(name: str) -> str:
+    """A distribution's name as the package index compares it (PEP 503):
+    ``Ruamel.YAML`` and ``ruamel_yaml`` are ``ruamel-yaml``."""
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def installed_distributions() -> dict[str, str]:
+    """Version of every distribution installed where this Python imports from,
+    by normalized name, sorted (the first found where one is installed twice, as
+    ``import`` finds it)."""
+    found: dict[str, str] = {}
+    for distribution in metadata.distributions():
+        name = distribution.metadata["Name"]
+        if name:  # a broken install has no name; it is no package of ours
+            found.setdefault(normalized_name(name), distribution.version)
+    return dict(sorted(found.items()))
+
+
+def lock_path(directory: str | os.PathLike, python: tuple[int, int] | None = None) -> Path:
+    """The lock of Python ``python`` ((major, minor); default the running one) in the
+    checkout whose top folder is ``directory``: ``requirements/py311.lock`` for 3.11."""
+    major, minor = python or sys.version_info[:2]
+    return Path(directory) / LOCK_FOLDER / f"py{major}{minor}.lock"
+
+
+def read_lock(path: str | os.PathLike) -> dict[str, str]:
+    """The pins of a lock file: ``{normalized name: version}``."""
+    text = Path(path).read_text(encoding="utf-8")
+    return {normalized_name(name): version for name, version in _PIN.findall(text)}
+
+
+def compare_with_lock(
+    directory: str | os.PathLike, installed: Mapping[str, str] | None = None
+) -> dict:
+    """How the installed packages compare with the running Python's lock.
+
+    Returns ``{"file", "matches", "differ", "note"}``: the lock (relative to the
+    checkout), whether every locked package is installed at its locked version, and
+    ``{name: {"locked", "installed"}}`` for each one that is not (``installed`` is
+    'not installed' for an extra left out). Without a lock for this Python in the
+    checkout (an installed wheel, a copied workflow, an unlocked Python), ``file`` and
+    ``matches`` are None and ``note`` says so; nothing is compared.
+
+    Parameters
+    ----------
+    directory : path
+        Top folder of the checkout (the Snakefile's).
+    installed : mapping, optional
+        ``{normalized name: version}``; default :func:`installed_distributions`.
+    """
+    path = lock_path(directory)
+    relative = f"{LOCK_FOLDER}/{path.name}"
+    if not path.is_file():
+        return {
+            "file": None,
+            "matches": None,
+            "differ": {},
+            "note": f"no {relative} for Python {platform.python_version()} in this copy "
+            "of the workflow (not a checkout, or an unlocked Python): versions not compared",
+        }
+    installed = installed_distributions() if installed is None else installed
+    differ = {
+        name: {"locked": locked, "installed": installed.get(name, NOT_INSTALLED)}
+        for name, locked in sorted(read_lock(path).items())
+        if installed.get(name) != locked
+    }
+    note = f"{len(differ)} package(s) differ from the lock" if differ else "as locked"
+    return {"file": relative, "matches": not differ, "differ": differ, "note": note}
+
+
+def lock_warnings(provenance: Mapping | None) -> list[str]:
+    """What a check says about a run's recorded versions against the lock: one line
+    naming every package that differs (locked and installed versions), a line when
+    nothing could be compared, nothing when the run was made as locked.
+
+    Parameters
+    ----------
+    provenance : mapping or None
+        The ``provenance`` block of a run's summary.json (:func:`run_provenance`).
+    """
+    lock = (provenance or {}).get("lock")
+    if not lock:
+        return ["summary.json records no comparison with the lock (an older run?)"]
+    if lock["matches"] is None:
+        return [lock["note"]]
+    if lock["matches"]:
+        return []
+    differences = ", ".join(
+        f"{name} {versions['installed']} (locked {versions['locked']})"
+        for name, versions in lock["differ"].items()
+    )
+    return [
+        f"the run's packages differ from {lock['file']}: {differences}; the locked "
+        f"environment: pip install --require-hashes -r {lock['file']} && "
+        "pip install --no-deps -e ."
+    ]
+
+
 def run_provenance(config: Mapping, directory: str | os.PathLike) -> dict:
-    """The provenance the article prints: ``commit``, ``date``, ``dirty``,
-    ``config_hash`` and ``versions`` (see the functions above).
+    """The provenance of a run (summary.json, and the article prints it): ``commit``,
+    ``date``, ``dirty``, ``config_hash``, ``versions`` (Python and the main packages),
+    ``installed`` (every installed distribution) and ``lock`` (how they compare with the
+    lock: :func:`compare_with_lock`).
 
     Parameters
     ----------
@@ -81,8 +196,11 @@ def run_provenance(config: Mapping, directory: str | os.PathLike) -> dict:
     directory : path
         A directory of the workflow's checkout (the Snakefile's).
     """
+    installed = installed_distributions()
     return {
         **git_state(directory),
         "config_hash": config_hash(config),
         "versions": package_versions(),
+        "installed": installed,
+        "lock": compare_with_lock(directory, installed),
     }
