@@ -1,23 +1,38 @@
 #!/usr/bin/env bash
-# Live SLURM test (issue 16): start a one-node SLURM cluster on this machine, run the
-# tiny test config through the SLURM profile (profiles/slurm), check that every job went
-# through sbatch (its SLURM job id in the Snakemake log and in SLURM's own job list),
-# and compare the results byte for byte with a local run of the same config.
+# Live SLURM test (issues 16, 32): start a one-node SLURM cluster on this machine, run the
+# tiny test config through the SLURM profile (profiles/slurm) with two faults a cluster
+# user meets, and compare the results byte for byte with a local run of the same config.
 #
-#   bash .ci/slurm_live_test.sh          (root; Debian packages installable or installed)
+#   1. Snakemake killed (SIGKILL: a dropped ssh session, an OOM kill) while its jobs run.
+#      The test then does what the README tells a user: retypes the command (Snakemake
+#      refuses: the directory is locked, "--unlock"), waits until the killed run's jobs
+#      have left the queue, `--unlock`s, and reruns the same command.
+#   2. One job of that rerun cancelled by `scancel` while it runs (preemption, a lost
+#      node): the profile's `retries: 1` resubmits it and the rerun finishes.
+#
+# Checked: every job of the local run ran through sbatch and COMPLETED exactly once in
+# SLURM (the jobs left running by the killed Snakemake count: the rerun keeps their
+# outputs), the one cancelled job excepted; Snakemake's error names the cancelled job and
+# its SLURM log; no output finished before the kill was rewritten by the rerun (inode,
+# time, SHA-256: .ci/output_snapshot.py); results/ identical to the local run. Each step
+# waits for a state it can see (a line of Snakemake's log, a job RUNNING in squeue, a
+# job's final state), polling with a time limit and a message naming what did not come.
 #
 # Everything lives in a temporary folder (munged with its own key and socket, slurm.conf,
 # SLURM's state and logs) and no system service is used (no systemd, no cgroups:
 # proctrack/linuxproc, task/none, no accounting). One file outside it: the executor
 # plugin strips SLURM_* variables (SLURM_CONF too) from the jobs, so srun inside a job
 # reads the default /etc/slurm/slurm.conf; the test links it to its own while it runs
-# (and skips if the machine has one). Every daemon started here is stopped by its pid
-# on exit, whatever happens, and the link removed. Where SLURM cannot be
-# started (not root, packages not installable, plugin missing) the test prints
-# "SKIPPED: <reason>" and exits 0; any failure once SLURM runs exits 1.
+# (and skips if the machine has one). On exit, whatever happens: the Snakemake processes
+# started here are stopped by their pid, SLURM's jobs cancelled (our cluster only), every
+# daemon started here stopped by its pid, any process still working in the temporary
+# folder killed, and the link removed. Where SLURM cannot be started (not root, packages
+# not installable, plugin missing) the test prints "slurm live test: SKIPPED: <reason>" and exits 0;
+# any failure once SLURM runs exits 1.
 #
 # Needs the project installed with the extra: pip install -e ".[test,slurm]".
-# Takes 2-5 minutes on 2 cores. Environment: HERTZCHAIN_SLURM_KEEP=1 keeps the folder.
+# The SLURM part takes about as long as the local run plus a few minutes (measured on 2
+# loaded cores: local 30 min, SLURM 35 min). HERTZCHAIN_SLURM_KEEP=1 keeps the folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -29,6 +44,7 @@ skip() {
     exit 0
 }
 say() { echo "slurm live test: $*"; }
+load() { cut -d ' ' -f 1-3 /proc/loadavg; } # the machine may be shared: times need it
 
 # ---- can SLURM be started here? -------------------------------------------------------
 [[ $(id -u) -eq 0 ]] || skip "not root (slurmctld, slurmd and munged need it)"
@@ -65,27 +81,58 @@ done
 # ---- a one-node cluster in a temporary folder ------------------------------------------
 WORK=$(mktemp -d /tmp/hertzchain-slurm.XXXXXX)
 chmod 755 "$WORK"
-PIDS=()
+PIDS=() # daemons started here
+SNAKE=  # the Snakemake process started here in the background, while it runs
 LINKED=0
+active_jobs() { squeue -h -t PENDING,RUNNING,CONFIGURING,COMPLETING,SUSPENDED -o %i "$@"; }
 cleanup() {
     local status=$?
     set +e
+    # Snakemake first (SIGTERM: it cancels its own jobs), killed if still there after 20 s.
+    if [[ -n $SNAKE ]] && alive "$SNAKE"; then
+        kill "$SNAKE"
+        for _ in $(seq 100); do
+            alive "$SNAKE" || break
+            sleep 0.2
+        done
+        alive "$SNAKE" && kill -KILL "$SNAKE"
+        say "stopped Snakemake (pid $SNAKE)"
+    fi
     if [[ -n ${SLURM_CONF:-} ]] && [[ ${#PIDS[@]} -gt 0 ]]; then
         scancel --user root >/dev/null 2>&1 # jobs left by a failed run, our cluster only
+        # Let SLURM end them (their processes) before its daemons stop: up to 30 s.
+        for _ in $(seq 150); do
+            [[ -z $(active_jobs 2>/dev/null) ]] && break
+            sleep 0.2
+        done
     fi
     for ((i = ${#PIDS[@]} - 1; i >= 0; i--)); do
         kill "${PIDS[i]}" 2>/dev/null
     done
     for pid in "${PIDS[@]}"; do
-        for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+        for _ in $(seq 50); do
+            kill -0 "$pid" 2>/dev/null || break
+            sleep 0.1
+        done
         kill -0 "$pid" 2>/dev/null && kill -KILL "$pid" 2>/dev/null
     done
     [[ ${#PIDS[@]} -gt 0 ]] && say "stopped daemons (pids ${PIDS[*]})"
+    # Last: any process still working in this test's folder (a job's processes whose
+    # slurmstepd did not end them). Only processes started by this test work there.
+    local left=()
+    for proc in /proc/[0-9]*; do
+        [[ $(readlink "$proc/cwd" 2>/dev/null) == "$WORK"/* ]] || continue
+        kill -KILL "${proc#/proc/}" 2>/dev/null && left+=("${proc#/proc/}")
+    done
+    [[ ${#left[@]} -gt 0 ]] && say "killed processes left in $WORK (pids ${left[*]})"
     [[ $LINKED == 1 ]] && rm -f "$SYSTEM_CONF"
     if [[ $status -ne 0 ]]; then
         for log in "$WORK"/munged.out "$WORK"/slurmctld.log "$WORK"/slurmd.log \
-            "$WORK"/slurm-run.log; do
-            [[ -f $log ]] && { echo "---- tail of $log"; tail -n 40 "$log"; }
+            "$WORK"/slurm-run*.log; do
+            [[ -f $log ]] && {
+                echo "---- tail of $log"
+                tail -n 40 "$log"
+            }
         done
     fi
     if [[ ${HERTZCHAIN_SLURM_KEEP:-0} == 1 ]]; then
@@ -99,16 +146,27 @@ trap cleanup EXIT
 trap 'exit 130' INT
 trap 'exit 143' TERM
 
-wait_for() { # wait_for SECONDS DESCRIPTION COMMAND...: poll until COMMAND succeeds
+fail() {
+    echo "slurm live test: FAILED: $*" >&2
+    exit 1
+}
+alive() { # alive PID: a process working in this test's folder (an exited one has no cwd)
+    [[ $(readlink "/proc/$1/cwd" 2>/dev/null) == "$WORK"/* ]]
+}
+# wait_until SECONDS DESCRIPTION COMMAND...: poll COMMAND every 0.2 s until it succeeds.
+# Fails after SECONDS, or at once if the Snakemake process watched ($WATCH) has exited.
+WATCH=
+wait_until() {
     local limit=$1 what=$2
     shift 2
-    for _ in $(seq $((limit * 5))); do
-        "$@" >/dev/null 2>&1 && return 0
+    local deadline=$((SECONDS + limit))
+    until "$@" >/dev/null 2>&1; do
+        [[ -z $WATCH ]] || alive "$WATCH" || fail "Snakemake (pid $WATCH) exited before: $what"
+        ((SECONDS < deadline)) || fail "$what: not seen within $limit s"
         sleep 0.2
     done
-    echo "slurm live test: FAILED: $what not up after $limit s" >&2
-    return 1
 }
+wait_for() { wait_until "$1" "$2 up" "${@:3}"; } # wait_for SECONDS DAEMON COMMAND...
 
 # munge, as the munge user, with its own key and socket.
 mkdir -p "$WORK/munge"
@@ -127,7 +185,10 @@ wait_for 10 munged munge --socket="$SOCKET" -n
 # slurm.conf: this host as the only node, described by slurmd -C.
 HOST=$(hostname -s)
 NODE=$(slurmd -C | head -n 1)
-[[ $NODE == NodeName=* ]] || { echo "slurmd -C gave: $NODE" >&2; exit 1; }
+[[ $NODE == NodeName=* ]] || {
+    echo "slurmd -C gave: $NODE" >&2
+    exit 1
+}
 mkdir -p "$WORK/state" "$WORK/spool"
 cat >"$WORK/slurm.conf" <<EOF
 ClusterName=hertzchain-ci
@@ -174,7 +235,7 @@ wait_for 30 "slurmd (node idle)" node_idle
 say "SLURM up: $(sinfo -h -o '%P %D %c CPUs %m MB %T')"
 
 # ---- the same config, locally and through SLURM, in two copies of the checkout --------
-copy_checkout() {
+copy_checkout() { # copy_checkout DEST [CACHE_FROM]: the checkout's files; numba's cache
     mkdir -p "$1"
     if git -C "$ROOT" rev-parse --git-dir >/dev/null 2>&1; then
         git -C "$ROOT" ls-files -z -co --exclude-standard | tar -C "$ROOT" --null -T - -cf - |
@@ -182,62 +243,177 @@ copy_checkout() {
     else
         tar -C "$ROOT" --exclude=./results --exclude=./.snakemake -cf - . | tar -C "$1" -xf -
     fi
-    # numba's compiled kernels, if the checkout has them (tar keeps the sources' times,
-    # which is what numba checks): saves compiling them twice more, a minute or more.
-    (cd "$ROOT" && find src -name '*.nbi' -o -name '*.nbc' | tar -cf - -T -) | tar -C "$1" -xf -
+    # numba's compiled kernels, from CACHE_FROM (a copy that ran) or the checkout (tar
+    # keeps the sources' times, which is what numba checks): saves compiling them in the
+    # jobs again, a minute or more.
+    (cd "${2:-$ROOT}" && find src -name '*.nbi' -o -name '*.nbc' | tar -cf - -T -) |
+        tar -C "$1" -xf -
 }
 copy_checkout "$WORK/local"
-copy_checkout "$WORK/slurm"
-
 start=$SECONDS
 (cd "$WORK/local" && PYTHONPATH=$WORK/local/src${PYTHONPATH:+:$PYTHONPATH} snakemake --cores 2 --configfile "$CONFIG" \
-    >"$WORK/local-run.log" 2>&1) || { tail -n 40 "$WORK/local-run.log"; exit 1; }
-say "local run: $((SECONDS - start)) s"
-
-start=$SECONDS
-# Settings of this test cluster only (a real cluster has sacct and an account):
-# squeue for job states, no account, first status check after 2 s.
-(cd "$WORK/slurm" && PYTHONPATH=$WORK/slurm/src${PYTHONPATH:+:$PYTHONPATH} snakemake --workflow-profile profiles/slurm \
-    --configfile "$CONFIG" --jobs 4 --latency-wait 5 \
-    --slurm-status-command squeue --slurm-no-account \
-    --slurm-init-seconds-before-status-checks 2 >"$WORK/slurm-run.log" 2>&1) || {
-    echo "slurm live test: FAILED: the SLURM run failed" >&2
+    >"$WORK/local-run.log" 2>&1) || {
+    tail -n 40 "$WORK/local-run.log"
     exit 1
 }
-say "SLURM run: $((SECONDS - start)) s"
+say "local run: $((SECONDS - start)) s (load average $(load))"
+copy_checkout "$WORK/slurm" "$WORK/local"
 
-# ---- every job went through sbatch --------------------------------------------------------
-mapfile -t IDS < <(sed -n 's/.*has been submitted with SLURM jobid \([0-9]*\).*/\1/p' \
-    "$WORK/slurm-run.log" | sort -n)
+# The command a user types (README), plus the settings of this test cluster only (a real
+# cluster has sacct and an account): squeue for job states, no account, first status
+# check after 2 s, 5 s for outputs to appear (one file system).
+COMMAND=(snakemake --workflow-profile profiles/slurm --configfile "$CONFIG" --jobs 4
+    --latency-wait 5 --slurm-status-command squeue --slurm-no-account
+    --slurm-init-seconds-before-status-checks 2)
+start_snakemake() { # start_snakemake LOG [ARGS...]: COMMAND in the background; pid: $SNAKE
+    local log=$1
+    shift
+    # Started from its folder (not cd in a subshell): its pid is Snakemake's from the start,
+    # and alive() sees it there.
+    cd "$WORK/slurm"
+    PYTHONPATH=$WORK/slurm/src${PYTHONPATH:+:$PYTHONPATH} "${COMMAND[@]}" "$@" >"$log" 2>&1 &
+    SNAKE=$!
+    cd "$ROOT"
+}
+finish_snakemake() { # finish_snakemake SECONDS WHAT: wait for $SNAKE; its status: $STATUS
+    WATCH=
+    wait_until "$1" "$2 to end" eval '! alive "$SNAKE"'
+    STATUS=0
+    wait "$SNAKE" || STATUS=$?
+    SNAKE=
+}
+run_snakemake() { # run_snakemake SECONDS LOG [ARGS...]: COMMAND, waited for; $STATUS
+    local limit=$1 log=$2
+    shift 2
+    start_snakemake "$log" "$@"
+    finish_snakemake "$limit" "snakemake ${*:-(the rerun)} ($log)"
+}
+run_id() { sed -n 's/.*SLURM run ID: \([0-9a-f-]*\).*/\1/p' "$1" | head -n 1; }
+finished_jobs() { grep -c '^Finished jobid' "$1" || true; }
+running_jobs() { squeue -h -n "$1" -t RUNNING -o %i | sort -n; } # of one run (job name)
+run_over() {
+    local left
+    left=$(active_jobs -n "$1") && [[ -z $left ]]
+} # squeue answered
+job_state() { scontrol show job "$1" | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p'; }
+job_ended() { [[ ! $(job_state "$1") =~ ^(PENDING|RUNNING|CONFIGURING|COMPLETING|SUSPENDED)$ ]]; }
+started_run() { [[ -n $(run_id "$1") ]]; }
+mid_run() { # mid_run LOG ID N: N jobs finished and one RUNNING in SLURM
+    (($(finished_jobs "$1") >= $3)) && [[ -n $(running_jobs "$2") ]]
+}
+
+# ---- fault 1: Snakemake killed while its jobs run --------------------------------------
+start=$SECONDS
+say "SLURM run 1: the README's command, killed (SIGKILL) once 5 jobs have finished"
+start_snakemake "$WORK/slurm-run-1.log"
+WATCH=$SNAKE
+wait_until 300 "the SLURM run ID in slurm-run-1.log" started_run "$WORK/slurm-run-1.log"
+RUN1=$(run_id "$WORK/slurm-run-1.log")
+wait_until 1200 "5 jobs finished and one RUNNING in SLURM (run 1, $RUN1)" \
+    mid_run "$WORK/slurm-run-1.log" "$RUN1" 5
+kill -KILL "$SNAKE" || fail "Snakemake (pid $SNAKE) ended before it could be killed"
+WATCH=
+wait "$SNAKE" || true
+say "killed Snakemake (pid $SNAKE) after $(finished_jobs "$WORK/slurm-run-1.log") finished jobs;" \
+    "SLURM jobs of run 1 still queued or running: $(active_jobs -n "$RUN1" | sort -n | tr '\n' ' ')"
+SNAKE=
+python "$ROOT/.ci/output_snapshot.py" record "$WORK/slurm" "$RUN" \
+    >"$WORK/finished-before-kill.tsv" 2>"$WORK/snapshot.err" ||
+    fail "could not record the finished outputs: $(cat "$WORK/snapshot.err")"
+say "before the kill: $(cat "$WORK/snapshot.err")"
+
+# What a user sees on retyping the command: the lock, and how to lift it.
+run_snakemake 300 "$WORK/slurm-run-locked.log"
+[[ $STATUS -ne 0 ]] && grep -q 'cannot be locked' "$WORK/slurm-run-locked.log" &&
+    grep -q -- '--unlock' "$WORK/slurm-run-locked.log" ||
+    fail "retyped after the kill, Snakemake did not stop on its lock naming --unlock (status $STATUS)"
+say "retyped: Snakemake refuses, \"Directory cannot be locked ... --unlock\""
+# The README: wait until the killed run's jobs (job name: its SLURM run ID) have left
+# the queue, then unlock.
+wait_until 1200 "the jobs of the killed run to end in SLURM (squeue -n $RUN1)" \
+    run_over "$RUN1"
+run_snakemake 300 "$WORK/slurm-run-unlock.log" --unlock
+[[ $STATUS -eq 0 ]] || fail "snakemake --unlock failed (status $STATUS)"
+
+# ---- fault 2: in the rerun, one job cancelled by scancel while it runs ----------------
+say "SLURM run 2: the same command again; one of its jobs cancelled once RUNNING"
+start_snakemake "$WORK/slurm-run-2.log"
+WATCH=$SNAKE
+wait_until 300 "the SLURM run ID in slurm-run-2.log" started_run "$WORK/slurm-run-2.log"
+RUN2=$(run_id "$WORK/slurm-run-2.log")
+CANCELLED=
+# A job seen RUNNING may end before scancel reaches it: then it is COMPLETED, not
+# CANCELLED, and the next RUNNING job is taken (three tries).
+for _ in 1 2 3; do
+    wait_until 600 "a job RUNNING in SLURM (run 2, $RUN2)" eval '[[ -n $(running_jobs "$RUN2") ]]'
+    job=$(running_jobs "$RUN2" | head -n 1)
+    rule=$(squeue -h -j "$job" -o %k || true)
+    scancel "$job" 2>/dev/null || true
+    wait_until 60 "SLURM job $job to end after scancel" job_ended "$job"
+    state=$(job_state "$job")
+    [[ $state == CANCELLED ]] && {
+        CANCELLED=$job
+        break
+    }
+    say "SLURM job $job ended $state before scancel reached it; taking the next RUNNING job"
+done
+[[ -n $CANCELLED ]] || fail "no RUNNING job of run 2 could be cancelled in three tries"
+say "cancelled SLURM job $CANCELLED (${rule:-?}) while RUNNING"
+finish_snakemake 1800 "SLURM run 2"
+[[ $STATUS -eq 0 ]] || fail "the rerun (SLURM run 2) failed (status $STATUS)"
+say "SLURM runs 1 and 2 with the faults: $((SECONDS - start)) s (load average $(load))"
+
+# ---- what Snakemake said about the cancelled job ---------------------------------------
+LOG2=$WORK/slurm-run-2.log
+grep -q "SLURM-job '$CANCELLED' failed, SLURM status is: 'CANCELLED'" "$LOG2" ||
+    fail "Snakemake's log does not report SLURM job $CANCELLED as CANCELLED"
+SLURM_LOG=$(grep -o "results/slurm-logs/[^ ,]*/$CANCELLED\.log" "$LOG2" | head -n 1)
+[[ -n $SLURM_LOG && -f $WORK/slurm/$SLURM_LOG ]] ||
+    fail "Snakemake's error does not name the SLURM log of job $CANCELLED, or it is missing"
+grep -q '^Trying to restart job' "$LOG2" || fail "the cancelled job was not resubmitted"
+say "Snakemake: \"SLURM-job '$CANCELLED' failed, SLURM status is: 'CANCELLED'\", log $SLURM_LOG; resubmitted (retries: 1)"
+
+# ---- no output finished before the kill was recomputed -----------------------------------
+if ! python "$ROOT/.ci/output_snapshot.py" check "$WORK/slurm" \
+    "$WORK/finished-before-kill.tsv" >"$WORK/rewritten.txt"; then
+    fail "the rerun rewrote outputs finished before the kill: $(tr '\n' ' ' <"$WORK/rewritten.txt")"
+fi
+say "the $(wc -l <"$WORK/finished-before-kill.tsv") outputs finished before the kill are untouched (inode, time, SHA-256)"
+
+# ---- every job went through sbatch and COMPLETED once ----------------------------------
+# Job ids from SLURM (job name: the run's SLURM run ID), not from Snakemake's log: a
+# Snakemake killed right after sbatch never printed "submitted with SLURM jobid" (seen:
+# the last two jobs of run 1).
+mapfile -t IDS < <(squeue --states=all -h -n "$RUN1,$RUN2" -o %i | sort -n)
 # Jobs of the local run (Snakemake logs each as "localrule <name>:"), less the target rule
 # `all`, which runs on the submitting host in the SLURM run too.
 LOCAL_JOBS=$(grep -E '^(local)?rule ' "$WORK/local-run.log" | grep -vc ' all:' || true)
-say "SLURM job listing (squeue --states=all):"
-printf '    %6s %-42s %-10s %4s %8s %8s\n' JOBID "RULE (sbatch --comment)" STATE CPUS MEMORY TIME
-squeue --states=all -h -o '%.6i %.42k %.10T %.4C %.8m %.8M' | sort -n | sed 's/^/    /'
-[[ ${#IDS[@]} -gt 0 ]] || { echo "slurm live test: FAILED: no job went through sbatch" >&2; exit 1; }
-[[ ${#IDS[@]} -eq $LOCAL_JOBS ]] || {
-    echo "slurm live test: FAILED: ${#IDS[@]} SLURM jobs, $LOCAL_JOBS local jobs" >&2
-    exit 1
-}
+say "SLURM job listing (squeue --states=all; NAME: the run's SLURM run ID):"
+printf '    %6s %-8s %-42s %-10s %4s %8s %8s\n' JOBID NAME "RULE (sbatch --comment)" STATE CPUS \
+    MEMORY TIME
+squeue --states=all -h -n "$RUN1,$RUN2" -o '%.6i %.8j %.42k %.10T %.4C %.8m %.8M' |
+    sort -n | sed 's/^/    /'
+[[ ${#IDS[@]} -gt 0 ]] || fail "no job went through sbatch"
+completed=0
 for id in "${IDS[@]}"; do
-    state=$(scontrol show job "$id" | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p')
-    [[ $state == COMPLETED ]] || {
-        echo "slurm live test: FAILED: SLURM job $id is $state" >&2
-        exit 1
-    }
+    state=$(job_state "$id")
+    if [[ $state == COMPLETED ]]; then
+        completed=$((completed + 1))
+    elif [[ $id != "$CANCELLED" ]]; then
+        fail "SLURM job $id is $state"
+    fi
 done
-say "${#IDS[@]} jobs submitted with sbatch, all COMPLETED in SLURM (ids ${IDS[0]}..${IDS[-1]})"
+((completed == LOCAL_JOBS)) ||
+    fail "$completed SLURM jobs COMPLETED, $LOCAL_JOBS local jobs (a job ran twice, or not at all)"
+say "${#IDS[@]} jobs submitted with sbatch (ids ${IDS[0]}..${IDS[-1]}): $completed COMPLETED," \
+    "one per job of the local run, and the cancelled one"
 
 # ---- same bytes -----------------------------------------------------------------------
 compare() {
     diff -r --brief --exclude=logs --exclude=benchmarks \
         "$WORK/local/results/$RUN" "$WORK/slurm/results/$RUN"
 }
-if ! compare; then
-    echo "slurm live test: FAILED: results differ between the local and the SLURM run" >&2
-    exit 1
-fi
+compare || fail "results differ between the local and the SLURM run"
 COUNT=$(cd "$WORK/slurm/results/$RUN" && find . -type f -not -path './logs/*' \
     -not -path './benchmarks/*' | wc -l)
 say "results/$RUN identical to the local run, byte for byte ($COUNT files; logs/ and benchmarks/ excluded)"
