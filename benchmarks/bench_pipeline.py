@@ -18,7 +18,7 @@ splits the wall time into start-up (Python, imports, numba cache), integration a
 writing the trace CSV, from the timestamps of the job logs.
 
 Then it **restyles one figure**: a line is added to the copy's
-``src/chain/report/fig4_delay_vs_force.py`` (Snakemake reruns on content, not on a
+``src/chain/report/figures/fig4_delay_vs_force.py`` (Snakemake reruns on content, not on a
 newer modification time alone) and the ``snakemake`` call that follows is timed, with
 the jobs it reran. ``--fresh`` first rebuilds with the numba cache empty, as a fresh
 clone does, then rebuilds again with the cache it filled.
@@ -54,7 +54,7 @@ ROOT = Path(__file__).resolve().parents[1]
 TARGET_S = {"rebuild": 25.0, "fresh": 60.0, "restyle": 3.0, "figure_job": 3.0}
 
 #: The figure module the restyle step "edits", and the rule that draws it.
-RESTYLED = ("src/chain/report/fig4_delay_vs_force.py", "fig4_delay_vs_force")
+RESTYLED = ("src/chain/report/figures/fig4_delay_vs_force.py", "fig4_delay_vs_force")
 
 
 def snakemake(args, work: Path) -> tuple[float, subprocess.CompletedProcess]:

@@ -25,11 +25,12 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.pipeline.headline import headline_numbers
-from chain.report.article import CAPTIONS, article_numbers, compile_article
-from chain.report.article_figures import PARAGRAPHS
-from chain.report.article_tables import ablation_tables, c_spread_tables
-from chain.report.claims import NOT_COMPUTED, TOLERANCES, claims
+from chain.report.numbers.claims import NOT_COMPUTED, TOLERANCES, claims, with_claims
+from chain.report.numbers.summary import decisions
 from chain.report.printed import plus_minus
+from chain.report.text.article import CAPTIONS, article_numbers, compile_article
+from chain.report.text.article_figures import PARAGRAPHS
+from chain.report.text.article_tables import ablation_tables, c_spread_tables
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = ROOT / "workflow" / "report" / "article.typ"
@@ -86,8 +87,14 @@ def figures(tmp_path_factory) -> dict[str, Path]:
     return paths
 
 
+def decided(summary, delays=None, ssw=None) -> dict:
+    """The fixture's summary as the summary step writes it: with its decisions and the
+    claim table (the article only formats them)."""
+    return with_claims({**summary, **decisions(summary)}, delays, ssw)
+
+
 def build(folder: Path, figures: dict, summary=SUMMARY, delays=None, ssw=None) -> Path:
-    numbers = article_numbers(summary, delays=delays, ssw=ssw, setup=None)
+    numbers = article_numbers(decided(summary, delays, ssw), setup=None)
     output = folder / "article.pdf"
     compile_article(SOURCE, numbers, list(figures.values()), output)
     return output
@@ -257,7 +264,7 @@ def test_a_run_without_experiment_says_so(tmp_path, figures):
     for key in ("delay_fits", "ssw_fits"):
         summary[key] = [r for r in summary[key] if r["source"] == "simulation"]
     summary.update(experiment_label="experiment", selection=[], experiment_tolerance=None)
-    numbers = article_numbers(summary, setup={"source": "none"})
+    numbers = article_numbers(decided(summary), setup={"source": "none"})
     shown = {k: v for k, v in figures.items() if k != "fig2_experiment_traces"}
     compile_article(SOURCE, numbers, list(shown.values()), tmp_path / "article.pdf")
     text = pdf_text(tmp_path / "article.pdf")
@@ -326,7 +333,7 @@ def test_provenance_is_printed(tmp_path, figures):
         "commit": "0123456789ab", "date": "2026-01-02", "dirty": True,
         "config_hash": "fedcba987654", "versions": {"numpy": "9.9.9"},
     }  # fmt: skip
-    numbers = article_numbers(SUMMARY, provenance=provenance)
+    numbers = article_numbers(decided(SUMMARY), provenance=provenance)
     compile_article(SOURCE, numbers, list(figures.values()), tmp_path / "article.pdf")
     text = re.sub(r"\s+", " ", raw_text(tmp_path / "article.pdf"))
     assert "0123456789ab with uncommitted changes" in text
@@ -389,7 +396,7 @@ def test_ssw_parity_and_experiment_claims_carry_their_numbers():
 
 def test_the_ssw_tables_are_written_for_reading():
     """Series named as the article names them, counts as "k of n", value ± error."""
-    from chain.report.article_ssw_tables import (
+    from chain.report.text.article_ssw_tables import (
         far_field_table,
         parity_table,
         resolution_table,

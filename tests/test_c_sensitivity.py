@@ -1,5 +1,5 @@
 """C against our choices (chain.pipeline.c_sensitivity), its summary entries
-(chain.report.spread) and its figure (chain.report.fig_c_sensitivity)."""
+(chain.report.numbers.spread) and its figure (chain.report.figures.fig_c_sensitivity)."""
 
 from pathlib import Path
 
@@ -16,8 +16,9 @@ from chain.pipeline.c_sensitivity import (
     sensitivity_plan,
     shifted_pairs,
 )
-from chain.report.fig_c_sensitivity import fig_c_sensitivity
-from chain.report.spread import ablation_summary, c_spread_summary, spread_markdown_rows
+from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
+from chain.report.numbers.spread import ablation_summary, c_spread_summary
+from chain.report.text.markdown_studies import spread_markdown_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 

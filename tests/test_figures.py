@@ -11,13 +11,13 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.physics.theory import cos6_pulse
-from chain.report import style
-from chain.report.fig1_setup import fig1_setup
-from chain.report.fig2_experiment_traces import fig2_experiment_traces
-from chain.report.fig3_simulation_traces import fig3_simulation_traces
-from chain.report.fig4_delay_vs_force import fig4_delay_vs_force
-from chain.report.fig5_ssw_vs_force import fig5_ssw_vs_force
-from chain.report.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
+from chain.report.figures import style
+from chain.report.figures.fig1_setup import fig1_setup
+from chain.report.figures.fig2_experiment_traces import fig2_experiment_traces
+from chain.report.figures.fig3_simulation_traces import fig3_simulation_traces
+from chain.report.figures.fig4_delay_vs_force import fig4_delay_vs_force
+from chain.report.figures.fig5_ssw_vs_force import fig5_ssw_vs_force
+from chain.report.figures.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
 from chain.traces import sensor_column, validate_traces
 
 #: Synthetic pulse: duration tau and the arrival times of the incident and crossed

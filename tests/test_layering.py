@@ -113,12 +113,12 @@ def test_no_forbidden_third_party_imports(module):
 def test_the_check_catches_an_uphill_import(tmp_path):
     """The test itself: physics importing the report, or pandas, is caught."""
     source = tmp_path / "bad.py"
-    source.write_text("import pandas\nfrom chain.report.summary import build_summary\n")
+    source.write_text("import pandas\nfrom chain.report.numbers.summary import build_summary\n")
     names = imports(source)
-    assert not allowed("chain.physics.model", "chain.report.summary")
-    assert "chain.report.summary" in names and "pandas" in {n.split(".")[0] for n in names}
-    assert allowed("chain.report.fig4_delay_vs_force", "chain.analysis.rows")
-    assert not allowed("chain.report.fig4_delay_vs_force", "chain.physics.integrator")
+    assert not allowed("chain.physics.model", "chain.report.numbers.summary")
+    assert "chain.report.numbers.summary" in names and "pandas" in {n.split(".")[0] for n in names}
+    assert allowed("chain.report.figures.fig4_delay_vs_force", "chain.analysis.rows")
+    assert not allowed("chain.report.figures.fig4_delay_vs_force", "chain.physics.integrator")
     assert not allowed("chain.analysis.ssw", "chain.apparatus.virtual")
 
 

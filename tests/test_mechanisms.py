@@ -24,7 +24,7 @@ from chain.pipeline.mechanisms import (
     setting_name,
     sweep_settings,
 )
-from chain.report.mechanisms import candidate_sentence, friction_sentence
+from chain.report.numbers.mechanisms import candidate_sentence, friction_sentence
 
 TINY = VirtualExperiment(
     n_beads=10,

@@ -1,4 +1,4 @@
-"""summary.json / summary.md (chain.report.summary, summary_md) from synthetic tables."""
+"""summary.json / summary.md (chain.report.numbers.summary, summary_md) from synthetic tables."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ import pytest
 
 from chain.analysis.selection import SKIPPED_REASON
 from chain.physics.theory import ballistic_constants as run_constants
-from chain.report.paper import PAPER
-from chain.report.summary import build_summary, summary_json, write_summary_json
-from chain.report.summary_md import summary_markdown, write_summary_markdown
+from chain.report.numbers.paper import PAPER
+from chain.report.numbers.summary import build_summary, summary_json, write_summary_json
+from chain.report.text.markdown import summary_markdown, write_summary_markdown
 
 #: The paper's Eq. 6 value and our recomputation agree to the printed digits.
 CBAL_PAPER_ABS_US = 0.02
@@ -169,7 +169,7 @@ def test_markdown_table(summary):
     assert "SSW slope, simulation, elastic, N = 26" in text
     assert "2.47 × the N = 25 slope" in text
     assert "C(viscoelastic) / C(elastic)" in text and "1.080" in text
-    assert "4.00e-10" in text
+    assert "4.00 × 10⁻¹⁰" in text  # a power of ten, never e-notation
     assert "rig: 46.0" in text  # the experiment's own pooled C
     assert "C, virtual experiment (model), rig, all N pooled, fit_full" in text
     assert "nan" not in text.lower().replace("nan ", "")
