@@ -370,12 +370,14 @@ def test_fig4_lines_fits_and_references():
     assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
     assert "(N)" in ax.get_xlabel() and "(µs)" in ax.get_ylabel()
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    # One name per series everywhere (chain.report.naming): the label names the virtual
+    # series, so another series of its rows ("rig") is named after it.
     assert sum(label.startswith("simulation, ") for label in labels) == 4
     # Experiment markers carry their chain's own fit; the dashed line is the pooled fit.
-    assert "virtual experiment (model), N = 25 (own fit C = 46.1 ± 0.8)" in labels
-    assert "virtual experiment (model), N = 26" in labels
+    assert "virtual experiment (model), rig, N = 25 (own fit C = 46.1 ± 0.8)" in labels
+    assert "virtual experiment (model), rig, N = 26" in labels
     assert any(
-        label.startswith("fit to virtual experiment (model), N pooled: C = 46.0 ± 0.6")
+        label.startswith("fit to virtual experiment (model), rig, N pooled: C = 46.0 ± 0.6")
         for label in labels
     )
     # An error of 0.2 keeps two figures (leading digits 10-35, chain.report.printed).
@@ -384,9 +386,9 @@ def test_fig4_lines_fits_and_references():
     assert any("exact Hertz" in label and "37.74" in label for label in labels)
     assert any("paper's experimental fit" in label and "45.9 ± 0.5" in label for label in labels)
     markers = {line.get_label(): line for line in ax.get_lines()}
-    n25 = markers["virtual experiment (model), N = 25 (own fit C = 46.1 ± 0.8)"]
+    n25 = markers["virtual experiment (model), rig, N = 25 (own fit C = 46.1 ± 0.8)"]
     assert n25.get_marker() == "o" and n25.get_markerfacecolor() == "none"
-    assert markers["virtual experiment (model), N = 26"].get_marker() == "x"
+    assert markers["virtual experiment (model), rig, N = 26"].get_marker() == "x"
     fits = [
         line for line in ax.get_lines() if " fit" in line.get_label() or "fit " in line.get_label()
     ]
@@ -447,7 +449,7 @@ def test_fig5_resolved_filled_measured_open_upper_limits_arrowed():
         for line in drawn
     )
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
-    label = next(t for t in labels if t.startswith("virtual experiment (model), N = 26"))
+    label = next(t for t in labels if t.startswith("virtual experiment (model), rig, N = 26"))
     assert (
         "5.00 ± 0.01 (stat) ± 0.20 (sys)" in label
         and f"{len(FORCES_N)} of {len(FORCES_N)} resolved" in label

@@ -186,3 +186,43 @@ def test_the_cycle_check_finds_a_loop():
     loop = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
     assert cycles(loop) == [["a", "b", "c"]]
     assert cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == []
+
+
+#: Inside the report: the text formats the numbers, the figures draw the tables; the
+#: numbers import neither, and printed/naming (shared by all three) import none of them.
+REPORT_ALLOWED = {
+    "numbers": {"numbers"},
+    "figures": {"figures", "numbers"},
+    "text": {"text", "numbers"},
+    "shared": set(),
+}
+
+
+def report_part(module: str) -> str:
+    parts = module.split(".")
+    return parts[2] if len(parts) > 3 and parts[2] in REPORT_ALLOWED else "shared"
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if m.startswith("chain.report.")))
+def test_report_parts_import_downhill(module):
+    """text -> numbers <- figures; chain.report.printed and .naming under all three."""
+    own = report_part(module)
+    wrong = sorted(
+        name
+        for name in imports(MODULES[module])
+        if name.startswith("chain.report.")
+        and name in MODULES
+        and report_part(name) != "shared"
+        and report_part(name) not in REPORT_ALLOWED[own]
+    )
+    assert not wrong, f"{module} ({own}) imports {wrong}"
+
+
+def test_report_package_inits_import_nothing():
+    """A figure's rule depends on the code its script imports (chain.pipeline.deps),
+    with the __init__ files on the way: they must not pull in the whole report."""
+    for name in (
+        "chain.report",
+        *(f"chain.report.{part}" for part in ("figures", "numbers", "text")),
+    ):
+        assert not {n for n in imports(MODULES[name]) if n.startswith("chain")}, name

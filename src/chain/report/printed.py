@@ -5,6 +5,7 @@ of ten, and tables of records whose columns are not known here."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 
 
@@ -179,6 +180,20 @@ def number(value, significant: int = 4, style: str = "text") -> str:
     return _with_power(minus(mantissa), minus(str(int(exponent))), style)
 
 
+#: A number in e-notation inside a text ("5.5e-10", "1e+03"); not part of a word or of a
+#: hexadecimal hash such as a commit's.
+E_NOTATION = re.compile(r"(?<![\w.])[+\-\u2212]?\d+(?:\.\d+)?[eE][+\-\u2212]?\d+(?![\w.])")
+
+
+def without_e_notation(text: str, style: str = "text") -> str:
+    """``text`` with every number in e-notation (:data:`E_NOTATION`) written with a
+    power of ten (:func:`number`, 4 significant digits): for texts made elsewhere, such
+    as a study's setting names ("gap_mean_m=1e-07" -> "gap_mean_m=1 × 10^−7")."""
+    return E_NOTATION.sub(
+        lambda match: number(float(match.group().replace("\u2212", "-")), 4, style), str(text)
+    )
+
+
 def percent(value: float, reference: float, decimals: int = 1) -> str:
     """Signed relative difference of ``value`` from ``reference``, in %."""
     return minus(f"{100.0 * (value / reference - 1.0):+.{decimals}f}") + " %"
@@ -194,7 +209,7 @@ def cell(value) -> str:
         return str(value)
     if isinstance(value, float):
         return number(value, 4)
-    return str(value)
+    return without_e_notation(str(value))
 
 
 def table_of(rows: Sequence[Mapping] | None) -> dict | None:

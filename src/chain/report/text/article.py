@@ -36,6 +36,7 @@ from chain.report.printed import (
     plus_minus_stat_sys,
     scientific,
     table_of,
+    without_e_notation,
 )
 from chain.report.text.article_figures import CAPTIONS, figure_text
 from chain.report.text.article_ssw_tables import (
@@ -133,7 +134,7 @@ def findings(summary: Mapping) -> dict:
         "mechanisms": None
         if study is None
         else {
-            "verdict": str(study.get("verdict", "")),
+            "verdict": without_e_notation(study.get("verdict", "")),
             "table": table_of(study.get("rows")),
             "check": table_of(_check_rows(study.get("lammps_check"))),
         },

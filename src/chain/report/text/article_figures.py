@@ -15,7 +15,7 @@ import math
 from collections.abc import Callable, Mapping
 
 from chain.report.naming import named
-from chain.report.printed import plus_minus
+from chain.report.printed import plus_minus, power_of_ten
 
 #: The section of the article that discusses each figure.
 FIGURE_SECTIONS = {
@@ -120,7 +120,7 @@ def _numbers_slopes(summary: Mapping) -> str:
 
 def _numbers_drift(summary: Mapping) -> str | None:
     drift = summary.get("max_energy_drift")
-    return None if drift is None else f"Largest relative energy drift {drift:.1e}."
+    return None if drift is None else f"Largest relative energy drift {power_of_ten(drift)}."
 
 
 def _numbers_chains(summary: Mapping) -> str | None:

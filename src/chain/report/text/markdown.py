@@ -22,7 +22,7 @@ from chain.analysis.selection import SKIPPED_REASON
 from chain.atomic import write_text_atomic
 from chain.report.naming import is_virtual, named
 from chain.report.numbers.paper import PAPER_ENERGY_DRIFT
-from chain.report.printed import percent, plus_minus, power_of_ten
+from chain.report.printed import number, percent, plus_minus, power_of_ten
 from chain.report.text.markdown_notes import notes
 from chain.report.text.markdown_ssw import Row, ssw_rows
 from chain.report.text.markdown_studies import mechanism_markdown, spread_markdown_rows
@@ -67,7 +67,7 @@ def _beads_line(summary) -> str:
     constants = summary["constants"]
     return (
         f"Beads: {summary['material']}, R = {summary['radius_m'] * 1e3:g} mm; "
-        f"κ = {constants['kappa_N_m1_5']:.4g} N/m^1.5, "
+        f"κ = {number(constants['kappa_N_m1_5'], 4, 'unicode')} N/m^1.5, "
         f"m = {constants['bead_mass_kg'] * 1e3:.4g} g. Headline estimator: "
         f"`{summary['main_estimator']}`. "
         "Paper values are quoted as printed in Santibanez et al. (Eq. 6, Fig. 4 caption, "

@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from chain.labels import VIRTUAL_LABEL
-from chain.report.printed import power_of_ten
+from chain.report.printed import power_of_ten, without_e_notation
 
 
 def spread_markdown_rows(summary: Mapping) -> list[tuple[str, str, str, str]]:
@@ -45,7 +45,8 @@ def mechanism_markdown(summary: Mapping) -> list[str]:
     study = summary.get("ssw_mechanisms")
     if not study:
         return []
-    lines = ["", "## Why are the measured SSW larger? (models, not data)", "", study["verdict"]]
+    verdict = without_e_notation(study["verdict"], "unicode")
+    lines = ["", "## Why are the measured SSW larger? (models, not data)", "", verdict]
     checks = study.get("lammps_check") or []
     if checks:
         worst_c = max(float(r["rel_diff_C"]) for r in checks)
