@@ -407,7 +407,7 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     drawn = sum(
         len(line.get_xdata())
         for line in fig.get_axes()[0].get_lines()
-        if line.get_label().startswith("x, N = ")
+        if line.get_label().startswith("x, rig, N = ")
     )
     assert drawn == len(experiment) - 4
     assert "Fig. 4 (fit_full): 4 of 48 left out (3 flagged ok = False, 1 ok but NaN" in caplog.text
