@@ -109,7 +109,7 @@ def friction_c_text(study: Mapping | None) -> str | None:
         moved = f"{low:.1f}" if f"{low:.1f}" == f"{high:.1f}" else f"{low:.1f}-{high:.1f}"
         c0 = next(r["C_frictionless"] for r in rows if r["N"] == n)
         parts.append(f"N = {n}: C {c0:.1f} -> {moved} µs N^(1/6)")
-    settings = ", ".join(dict.fromkeys(r["setting"] for r in rows))
+    settings = "; ".join(dict.fromkeys(r["setting"] for r in rows))
     return f"{'; '.join(parts)} (LAMMPS; {settings})"
 
 
