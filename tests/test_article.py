@@ -25,11 +25,12 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.pipeline.headline import headline_numbers
-from chain.report.article import CAPTIONS, article_numbers, compile_article
-from chain.report.article_figures import PARAGRAPHS
-from chain.report.article_tables import ablation_tables, c_spread_tables
-from chain.report.claims import NOT_COMPUTED, TOLERANCES, claims
-from chain.report.printed import plus_minus
+from chain.report.numbers.claims import NOT_COMPUTED, TOLERANCES, claims, with_claims
+from chain.report.numbers.summary import decisions
+from chain.report.printed import E_NOTATION, plus_minus
+from chain.report.text.article import CAPTIONS, article_numbers, compile_article
+from chain.report.text.article_figures import PARAGRAPHS
+from chain.report.text.article_tables import ablation_tables, c_spread_tables
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = ROOT / "workflow" / "report" / "article.typ"
@@ -86,8 +87,14 @@ def figures(tmp_path_factory) -> dict[str, Path]:
     return paths
 
 
+def decided(summary, delays=None, ssw=None) -> dict:
+    """The fixture's summary as the summary step writes it: with its decisions and the
+    claim table (the article only formats them)."""
+    return with_claims({**summary, **decisions(summary)}, delays, ssw)
+
+
 def build(folder: Path, figures: dict, summary=SUMMARY, delays=None, ssw=None) -> Path:
-    numbers = article_numbers(summary, delays=delays, ssw=ssw, setup=None)
+    numbers = article_numbers(decided(summary, delays, ssw), setup=None)
     output = folder / "article.pdf"
     compile_article(SOURCE, numbers, list(figures.values()), output)
     return output
@@ -257,7 +264,7 @@ def test_a_run_without_experiment_says_so(tmp_path, figures):
     for key in ("delay_fits", "ssw_fits"):
         summary[key] = [r for r in summary[key] if r["source"] == "simulation"]
     summary.update(experiment_label="experiment", selection=[], experiment_tolerance=None)
-    numbers = article_numbers(summary, setup={"source": "none"})
+    numbers = article_numbers(decided(summary), setup={"source": "none"})
     shown = {k: v for k, v in figures.items() if k != "fig2_experiment_traces"}
     compile_article(SOURCE, numbers, list(shown.values()), tmp_path / "article.pdf")
     text = pdf_text(tmp_path / "article.pdf")
@@ -326,7 +333,7 @@ def test_provenance_is_printed(tmp_path, figures):
         "commit": "0123456789ab", "date": "2026-01-02", "dirty": True,
         "config_hash": "fedcba987654", "versions": {"numpy": "9.9.9"},
     }  # fmt: skip
-    numbers = article_numbers(SUMMARY, provenance=provenance)
+    numbers = article_numbers(decided(SUMMARY), provenance=provenance)
     compile_article(SOURCE, numbers, list(figures.values()), tmp_path / "article.pdf")
     text = re.sub(r"\s+", " ", raw_text(tmp_path / "article.pdf"))
     assert "0123456789ab with uncommitted changes" in text
@@ -389,7 +396,7 @@ def test_ssw_parity_and_experiment_claims_carry_their_numbers():
 
 def test_the_ssw_tables_are_written_for_reading():
     """Series named as the article names them, counts as "k of n", value ± error."""
-    from chain.report.article_ssw_tables import (
+    from chain.report.text.article_ssw_tables import (
         far_field_table,
         parity_table,
         resolution_table,
@@ -412,3 +419,55 @@ def test_the_ssw_tables_are_written_for_reading():
     assert separation["rows"][0][4:] == ["7", "6.5", "1.012"]
     assert all(table(None, label) is None for table in
                (resolution_table, separation_table, parity_table, far_field_table))  # fmt: skip
+
+
+#: A mechanism study whose numbers and setting names {:g} writes in e-notation.
+SMALL_NUMBERS = {
+    "max_energy_drift": 5.5e-10,
+    "ssw_mechanisms": {
+        "verdict": "Of the other candidates, gaps between beads (gap_mean_m=1e-07) comes "
+        "closest.",
+        "rows": [{"mechanism": "gaps between beads", "setting": "gap_mean_m=1e-07",
+                  "N": 25, "ssw_over_Fm": 0.0246, "ratio_to_frictionless": 1.29}],
+        "lammps_check": [{"N": 25, "model": "elastic", "C_kernel": 41.43, "C_lammps": 41.43,
+                          "rel_diff_C": 7.121e-08, "max_trace_diff_over_Fm": 2.62e-07}],
+        "friction_C": [],
+    },
+}  # fmt: skip
+
+
+def test_no_raw_e_notation_in_the_article(tmp_path, figures):
+    """Issue 32 item 5: the article writes 5.5 × 10⁻¹⁰, never 5.5e-10: not in its typst
+    source, not in the strings it is given, not in the text of the PDF."""
+    assert not E_NOTATION.findall(SOURCE.read_text())
+    summary = {**copy.deepcopy(SUMMARY), **FINDINGS, **SMALL_NUMBERS}
+    numbers = article_numbers(decided(summary))
+    strings = json.dumps(numbers, ensure_ascii=False)
+    assert not E_NOTATION.findall(strings), E_NOTATION.findall(strings)
+    text = raw_text(build(tmp_path, figures, summary=summary))
+    assert not E_NOTATION.findall(text), E_NOTATION.findall(text)
+    assert "5.5×10" in re.sub(r"\s+", "", text)  # the drift, with its power of ten
+
+
+def test_the_why_not_of_the_simulated_c_quotes_the_mechanism_study():
+    """With the mechanism study, the claim that Eq. 1 misses the measured Δ says what
+    friction does to C (issue 31 item 4); without it, the paper's explanation."""
+    name = "Simulations of Eq. 1 close to the measured Δ (simulation, viscoelastic)"
+    study = {
+        "verdict": "",
+        "rows": [],
+        "lammps_check": [],
+        "friction_C": [
+            {"N": 25, "setting": "mu_t=0.3, mu_b=0", "C_frictionless": 44.16, "C": 49.81},
+            {"N": 25, "setting": "mu_t=0.3, mu_b=0.3", "C_frictionless": 44.16, "C": 45.08},
+        ],
+    }
+    far = with_exponent(SUMMARY, "viscoelastic", -0.1)
+    for row in far["delay_fits"]:
+        if row["model"] == "viscoelastic" and row["N"] == "pooled":
+            row["C_us_N16"] = 60.0  # far from C_exp: the why-not is printed
+    plain = {row["claim"]: row["why"] for row in claims(far)}
+    assert plain[name] == "no track friction or bead rotation modelled (the paper's explanation)"
+    quoted = {row["claim"]: row["why"] for row in claims({**far, "ssw_mechanisms": study})}
+    assert "mechanism study models both" in quoted[name]
+    assert "N = 25: C 44.2 -> 45.1-49.8 µs N^(1/6)" in quoted[name]

@@ -1,5 +1,5 @@
 """C against our choices (chain.studies.c_sensitivity), its summary entries
-(chain.report.spread) and its figure (chain.report.fig_c_sensitivity)."""
+(chain.report.numbers.spread) and its figure (chain.report.figures.fig_c_sensitivity)."""
 
 from pathlib import Path
 
@@ -12,8 +12,9 @@ from snakemake.utils import validate
 from chain.apparatus.shots import simulate_shots
 from chain.physics.model import uniform_chain
 from chain.pipeline.plan import launch_speeds
-from chain.report.fig_c_sensitivity import fig_c_sensitivity
-from chain.report.spread import ablation_summary, c_spread_summary, spread_markdown_rows
+from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
+from chain.report.numbers.spread import ablation_summary, c_spread_summary
+from chain.report.text.markdown_studies import spread_markdown_rows
 from chain.studies.c_sensitivity import (
     c_sensitivity_table,
     sensitivity_plan,

@@ -11,8 +11,8 @@ from matplotlib.figure import Figure
 from chain.analysis.ssw_track import field_table, ssw_track_table
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
-from chain.report.fig_ssw_spacetime import fig_ssw_spacetime
-from chain.report.style import save_figure
+from chain.report.figures.fig_ssw_spacetime import fig_ssw_spacetime
+from chain.report.figures.style import save_figure
 
 
 @pytest.fixture(scope="module")

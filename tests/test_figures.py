@@ -11,13 +11,13 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.physics.theory import cos6_pulse
-from chain.report import style
-from chain.report.fig1_setup import fig1_setup
-from chain.report.fig2_experiment_traces import fig2_experiment_traces
-from chain.report.fig3_simulation_traces import fig3_simulation_traces
-from chain.report.fig4_delay_vs_force import fig4_delay_vs_force
-from chain.report.fig5_ssw_vs_force import fig5_ssw_vs_force
-from chain.report.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
+from chain.report.figures import style
+from chain.report.figures.fig1_setup import fig1_setup
+from chain.report.figures.fig2_experiment_traces import fig2_experiment_traces
+from chain.report.figures.fig3_simulation_traces import fig3_simulation_traces
+from chain.report.figures.fig4_delay_vs_force import fig4_delay_vs_force
+from chain.report.figures.fig5_ssw_vs_force import fig5_ssw_vs_force
+from chain.report.figures.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
 from chain.traces import sensor_column, validate_traces
 
 #: Synthetic pulse: duration tau and the arrival times of the incident and crossed
@@ -370,12 +370,14 @@ def test_fig4_lines_fits_and_references():
     assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
     assert "(N)" in ax.get_xlabel() and "(µs)" in ax.get_ylabel()
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    # One name per series everywhere (chain.report.naming): the label names the virtual
+    # series, so another series of its rows ("rig") is named after it.
     assert sum(label.startswith("simulation, ") for label in labels) == 4
     # Experiment markers carry their chain's own fit; the dashed line is the pooled fit.
-    assert "virtual experiment (model), N = 25 (own fit C = 46.1 ± 0.8)" in labels
-    assert "virtual experiment (model), N = 26" in labels
+    assert "virtual experiment (model), rig, N = 25 (own fit C = 46.1 ± 0.8)" in labels
+    assert "virtual experiment (model), rig, N = 26" in labels
     assert any(
-        label.startswith("fit to virtual experiment (model), N pooled: C = 46.0 ± 0.6")
+        label.startswith("fit to virtual experiment (model), rig, N pooled: C = 46.0 ± 0.6")
         for label in labels
     )
     # An error of 0.2 keeps two figures (leading digits 10-35, chain.report.printed).
@@ -384,9 +386,9 @@ def test_fig4_lines_fits_and_references():
     assert any("exact Hertz" in label and "37.74" in label for label in labels)
     assert any("paper's experimental fit" in label and "45.9 ± 0.5" in label for label in labels)
     markers = {line.get_label(): line for line in ax.get_lines()}
-    n25 = markers["virtual experiment (model), N = 25 (own fit C = 46.1 ± 0.8)"]
+    n25 = markers["virtual experiment (model), rig, N = 25 (own fit C = 46.1 ± 0.8)"]
     assert n25.get_marker() == "o" and n25.get_markerfacecolor() == "none"
-    assert markers["virtual experiment (model), N = 26"].get_marker() == "x"
+    assert markers["virtual experiment (model), rig, N = 26"].get_marker() == "x"
     fits = [
         line for line in ax.get_lines() if " fit" in line.get_label() or "fit " in line.get_label()
     ]
@@ -405,7 +407,7 @@ def test_fig4_and_fig5_leave_out_flagged_and_nan_rows_with_a_logged_count(caplog
     drawn = sum(
         len(line.get_xdata())
         for line in fig.get_axes()[0].get_lines()
-        if line.get_label().startswith("x, N = ")
+        if line.get_label().startswith("x, rig, N = ")
     )
     assert drawn == len(experiment) - 4
     assert "Fig. 4 (fit_full): 4 of 48 left out (3 flagged ok = False, 1 ok but NaN" in caplog.text
@@ -447,7 +449,7 @@ def test_fig5_resolved_filled_measured_open_upper_limits_arrowed():
         for line in drawn
     )
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
-    label = next(t for t in labels if t.startswith("virtual experiment (model), N = 26"))
+    label = next(t for t in labels if t.startswith("virtual experiment (model), rig, N = 26"))
     assert (
         "5.00 ± 0.01 (stat) ± 0.20 (sys)" in label
         and f"{len(FORCES_N)} of {len(FORCES_N)} resolved" in label

@@ -119,12 +119,12 @@ def test_no_forbidden_third_party_imports(module):
 def test_the_check_catches_an_uphill_import(tmp_path):
     """The test itself: physics importing the report, or pandas, is caught."""
     source = tmp_path / "bad.py"
-    source.write_text("import pandas\nfrom chain.report.summary import build_summary\n")
+    source.write_text("import pandas\nfrom chain.report.numbers.summary import build_summary\n")
     names = imports(source)
-    assert not allowed("chain.physics.model", "chain.report.summary")
-    assert "chain.report.summary" in names and "pandas" in {n.split(".")[0] for n in names}
-    assert allowed("chain.report.fig4_delay_vs_force", "chain.analysis.rows")
-    assert not allowed("chain.report.fig4_delay_vs_force", "chain.physics.integrator")
+    assert not allowed("chain.physics.model", "chain.report.numbers.summary")
+    assert "chain.report.numbers.summary" in names and "pandas" in {n.split(".")[0] for n in names}
+    assert allowed("chain.report.figures.fig4_delay_vs_force", "chain.analysis.rows")
+    assert not allowed("chain.report.figures.fig4_delay_vs_force", "chain.physics.integrator")
     assert not allowed("chain.analysis.ssw", "chain.apparatus.virtual")
     assert allowed("chain.pipeline.config", "chain.studies.ablation")
     assert not allowed("chain.studies.ablation", "chain.pipeline.virtual_config")
@@ -195,3 +195,43 @@ def test_the_cycle_check_finds_a_loop():
     loop = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
     assert cycles(loop) == [["a", "b", "c"]]
     assert cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == []
+
+
+#: Inside the report: the text formats the numbers, the figures draw the tables; the
+#: numbers import neither, and printed/naming (shared by all three) import none of them.
+REPORT_ALLOWED = {
+    "numbers": {"numbers"},
+    "figures": {"figures", "numbers"},
+    "text": {"text", "numbers"},
+    "shared": set(),
+}
+
+
+def report_part(module: str) -> str:
+    parts = module.split(".")
+    return parts[2] if len(parts) > 3 and parts[2] in REPORT_ALLOWED else "shared"
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if m.startswith("chain.report.")))
+def test_report_parts_import_downhill(module):
+    """text -> numbers <- figures; chain.report.printed and .naming under all three."""
+    own = report_part(module)
+    wrong = sorted(
+        name
+        for name in imports(MODULES[module])
+        if name.startswith("chain.report.")
+        and name in MODULES
+        and report_part(name) != "shared"
+        and report_part(name) not in REPORT_ALLOWED[own]
+    )
+    assert not wrong, f"{module} ({own}) imports {wrong}"
+
+
+def test_report_package_inits_import_nothing():
+    """A figure's rule depends on the code its script imports (chain.pipeline.deps),
+    with the __init__ files on the way: they must not pull in the whole report."""
+    for name in (
+        "chain.report",
+        *(f"chain.report.{part}" for part in ("figures", "numbers", "text")),
+    ):
+        assert not {n for n in imports(MODULES[name]) if n.startswith("chain")}, name

@@ -21,7 +21,7 @@ from chain.errors import ParameterError
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
-from chain.report.mechanisms import candidate_sentence, friction_sentence
+from chain.report.numbers.mechanisms import candidate_sentence, friction_sentence
 from chain.studies.mechanism_settings import candidate_variants, setting_name, sweep_settings
 from chain.studies.mechanism_table import mechanism_rows
 

@@ -506,7 +506,7 @@ def test_a_failing_figure_save_leaves_no_file(tmp_path, monkeypatch):
     writing part of the file leaves nothing under the final names."""
     from matplotlib.figure import Figure
 
-    from chain.report.style import save_figure
+    from chain.report.figures.style import save_figure
 
     fig = Figure()
     fig.add_subplot().plot([0, 1], [1, 0])
@@ -522,16 +522,16 @@ def test_a_failing_figure_save_leaves_no_file(tmp_path, monkeypatch):
 
 
 def test_a_failing_summary_leaves_no_partial_file(tmp_path, monkeypatch):
-    import chain.report.summary
-    import chain.report.summary_md
+    import chain.report.numbers.summary
+    import chain.report.text.markdown
 
     def fail(summary):
         raise RuntimeError("bad summary")
 
-    chain.report.summary.write_summary_json({"run_name": "x"}, tmp_path / "s.json")
-    monkeypatch.setattr(chain.report.summary_md, "summary_markdown", fail)
+    chain.report.numbers.summary.write_summary_json({"run_name": "x"}, tmp_path / "s.json")
+    monkeypatch.setattr(chain.report.text.markdown, "summary_markdown", fail)
     with pytest.raises(RuntimeError, match="bad summary"):
-        chain.report.summary_md.write_summary_markdown(tmp_path / "s.json", tmp_path / "s.md")
+        chain.report.text.markdown.write_summary_markdown(tmp_path / "s.json", tmp_path / "s.md")
     # The JSON is complete on its own; the Markdown never appears, even partly.
     assert listing(tmp_path) == ["s.json"]
     assert json.loads((tmp_path / "s.json").read_text()) == {"run_name": "x"}

@@ -1,7 +1,8 @@
-"""summary.json / summary.md (chain.report.summary, summary_md) from synthetic tables."""
+"""summary.json / summary.md (chain.report.numbers.summary, summary_md) from synthetic tables."""
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 
@@ -11,9 +12,10 @@ import pytest
 
 from chain.analysis.selection import SKIPPED_REASON
 from chain.physics.theory import ballistic_constants as run_constants
-from chain.report.paper import PAPER
-from chain.report.summary import build_summary, summary_json, write_summary_json
-from chain.report.summary_md import summary_markdown, write_summary_markdown
+from chain.report.numbers.paper import PAPER
+from chain.report.numbers.summary import build_summary, summary_json, write_summary_json
+from chain.report.printed import E_NOTATION
+from chain.report.text.markdown import summary_markdown, write_summary_markdown
 
 #: The paper's Eq. 6 value and our recomputation agree to the printed digits.
 CBAL_PAPER_ABS_US = 0.02
@@ -169,7 +171,7 @@ def test_markdown_table(summary):
     assert "SSW slope, simulation, elastic, N = 26" in text
     assert "2.47 × the N = 25 slope" in text
     assert "C(viscoelastic) / C(elastic)" in text and "1.080" in text
-    assert "4.00e-10" in text
+    assert "4.00 × 10⁻¹⁰" in text  # a power of ten, never e-notation
     assert "rig: 46.0" in text  # the experiment's own pooled C
     assert "C, virtual experiment (model), rig, all N pooled, fit_full" in text
     assert "nan" not in text.lower().replace("nan ", "")
@@ -408,3 +410,29 @@ def test_ssw_keys_and_rows():
     )
     assert "SSW slope ratio, simulation, elastic, N = 26 : N = 25 | > 1" in text
     assert "SSW far field, even : odd, simulation, elastic, N = 120 : 121 | > 1" in text
+
+
+def test_markdown_has_no_raw_e_notation(summary):
+    """Issue 32 item 5: very small or large numbers are written with a power of ten,
+    in the rendered summary.md as in the article (chain.report.printed.power_of_ten)."""
+    data = copy.deepcopy(summary)
+    data["max_energy_drift"] = 5.48e-10
+    data["constants"]["kappa_N_m1_5"] = 1.199e10
+    data["ssw_mechanisms"] = {
+        "verdict": "Of the candidates, gaps between beads (gap_mean_m=1e-07) comes closest.",
+        "rows": [],
+        "lammps_check": [{"rel_diff_C": 3.5e-06, "max_trace_diff_over_Fm": 3.2e-05}],
+    }
+    data["attenuation"] = [
+        {"model": "elastic", "N": 25, "F_S1_low_N": 9.99, "ratio_low": 1.0,
+         "F_S1_high_N": 1030.0, "ratio_high": 1.0},
+    ]  # fmt: skip
+    text = summary_markdown(data)
+    assert not E_NOTATION.findall(text), E_NOTATION.findall(text)
+    assert "5.48 × 10⁻¹⁰" in text and "1 × 10⁻⁷" in text and "3.5 × 10⁻⁶" in text
+    assert "1.199 × 10¹⁰" in text and "1.03 × 10³ N" in text
+
+
+def test_e_notation_pattern_finds_numbers_not_hashes():
+    found = E_NOTATION.findall("drift 5.5e-10, 1e+03 N, -2E5; commit 7ef8d179e4b2, T1e5")
+    assert found == ["5.5e-10", "1e+03", "-2E5"]

@@ -1,4 +1,4 @@
-"""The sweep table (chain.studies.sweep) and its C(N) figure (chain.report.fig_c_vs_N)."""
+"""The sweep table (chain.studies.sweep) and its C(N) figure (chain.report.figures.fig_c_vs_N)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.report.fig_c_vs_N import fig_c_vs_N
+from chain.report.figures.fig_c_vs_N import fig_c_vs_N
 from chain.studies.sweep import SWEEP_COLUMNS, sweep_table
 
 ETA = {"elastic": 0.0, "viscoelastic": 0.58e-6}

@@ -1,6 +1,6 @@
-# Figures: one rule, one script and one module (src/chain/report/<rule>.py) per figure.
+# Figures: one rule, one script and one module (src/chain/report/figures/<rule>.py) per figure.
 # They read tables and traces only, so restyling a figure redraws it and nothing else;
-# editing the shared style (report/style.py) redraws every figure.
+# editing the shared style (report/figures/style.py) redraws every figure.
 
 
 rule fig1_setup:

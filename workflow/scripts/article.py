@@ -1,19 +1,16 @@
-"""article.pdf: the reproduction as an article (chain.report.article + article.typ)."""
+"""article.pdf: the reproduction as an article (chain.report.text.article + article.typ)."""
 
 import json
 
-import pandas as pd
 from _logging import start
 
-from chain.report.article import article_numbers, compile_article
+from chain.report.text.article import article_numbers, compile_article
 
 log = start(snakemake)
 with open(snakemake.input.summary, encoding="utf-8") as stream:
     summary = json.load(stream)
 numbers = article_numbers(
     summary,
-    delays=pd.read_csv(snakemake.input.delays),
-    ssw=pd.read_csv(snakemake.input.ssw),
     setup=snakemake.params.setup,
     provenance=snakemake.params.provenance,
 )

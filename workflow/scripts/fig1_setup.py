@@ -1,11 +1,11 @@
-"""Fig. 1, the setup, drawn from the configured chains (chain.report.fig1_setup)."""
+"""Fig. 1, the setup, drawn from the configured chains (chain.report.figures.fig1_setup)."""
 
 from pathlib import Path
 
 from _logging import start
 
-from chain.report.fig1_setup import fig1_setup
-from chain.report.style import save_figure
+from chain.report.figures.fig1_setup import fig1_setup
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 p = snakemake.params

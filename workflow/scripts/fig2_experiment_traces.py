@@ -1,5 +1,5 @@
 """Fig. 2: experiment forces at the sensor beads, a shot the acceptance protocol kept
-(chain.report.fig2_experiment_traces)."""
+(chain.report.figures.fig2_experiment_traces)."""
 
 from pathlib import Path
 
@@ -7,8 +7,8 @@ import pandas as pd
 from _inputs import selection
 from _logging import start
 
-from chain.report.fig2_experiment_traces import fig2_experiment_traces
-from chain.report.style import save_figure
+from chain.report.figures.fig2_experiment_traces import fig2_experiment_traces
+from chain.report.figures.style import save_figure
 from chain.traces import read_traces
 
 log = start(snakemake)

@@ -1,12 +1,12 @@
-"""Fig. 3: simulated forces at the sensor beads (chain.report.fig3_simulation_traces)."""
+"""Fig. 3: simulated forces at the sensor beads (chain.report.figures.fig3_simulation_traces)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.fig3_simulation_traces import fig3_simulation_traces
-from chain.report.style import save_figure
+from chain.report.figures.fig3_simulation_traces import fig3_simulation_traces
+from chain.report.figures.style import save_figure
 from chain.traces import read_traces
 
 log = start(snakemake)

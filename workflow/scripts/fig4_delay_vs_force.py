@@ -1,4 +1,4 @@
-"""Fig. 4: |Delta| against F_m (chain.report.fig4_delay_vs_force)."""
+"""Fig. 4: |Delta| against F_m (chain.report.figures.fig4_delay_vs_force)."""
 
 from pathlib import Path
 
@@ -6,8 +6,8 @@ import pandas as pd
 from _logging import start
 
 from chain.physics.theory import ballistic_constants
-from chain.report.fig4_delay_vs_force import fig4_delay_vs_force
-from chain.report.style import save_figure
+from chain.report.figures.fig4_delay_vs_force import fig4_delay_vs_force
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 p = snakemake.params

@@ -1,5 +1,5 @@
 """Fig. 5: SSW amplitude against incident amplitude at the sensors, and SSW / F_m along
-the chain (chain.report.fig5_ssw_vs_force)."""
+the chain (chain.report.figures.fig5_ssw_vs_force)."""
 
 from pathlib import Path
 
@@ -7,8 +7,8 @@ import pandas as pd
 from _logging import start
 
 from chain.analysis.ssw_track import sensor_distance
-from chain.report.fig5_ssw_vs_force import fig5_ssw_vs_force
-from chain.report.style import save_figure
+from chain.report.figures.fig5_ssw_vs_force import fig5_ssw_vs_force
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig5_ssw_vs_force(

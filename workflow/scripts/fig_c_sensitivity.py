@@ -1,12 +1,12 @@
-"""Supplementary figure: C against our choices (chain.report.fig_c_sensitivity)."""
+"""Supplementary figure: C against our choices (chain.report.figures.fig_c_sensitivity)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.fig_c_sensitivity import fig_c_sensitivity
-from chain.report.style import save_figure
+from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_c_sensitivity(pd.read_csv(snakemake.input.table))

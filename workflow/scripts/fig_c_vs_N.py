@@ -1,12 +1,12 @@
-"""Sweep figure: C against N, odd and even (chain.report.fig_c_vs_N.fig_c_vs_N)."""
+"""Sweep figure: C against N, odd and even (chain.report.figures.fig_c_vs_N.fig_c_vs_N)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.fig_c_vs_N import fig_c_vs_N
-from chain.report.style import save_figure
+from chain.report.figures.fig_c_vs_N import fig_c_vs_N
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_c_vs_N(pd.read_csv(snakemake.input.sweep))

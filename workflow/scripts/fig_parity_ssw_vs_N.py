@@ -1,12 +1,12 @@
-"""What-if figure: SSW slope against N, odd and even (chain.report.fig_parity_ssw_vs_N)."""
+"""What-if figure: SSW slope against N, odd and even (chain.report.figures.fig_parity_ssw_vs_N)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
-from chain.report.style import save_figure
+from chain.report.figures.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_parity_ssw_vs_N(

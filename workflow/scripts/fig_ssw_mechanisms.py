@@ -1,13 +1,13 @@
 """The mechanism figure: SSW/F_m at S2 per mechanism and setting
-(chain.report.fig_ssw_mechanisms)."""
+(chain.report.figures.fig_ssw_mechanisms)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.fig_ssw_mechanisms import fig_ssw_mechanisms
-from chain.report.style import save_figure
+from chain.report.figures.fig_ssw_mechanisms import fig_ssw_mechanisms
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_ssw_mechanisms(pd.read_csv(snakemake.input.table))

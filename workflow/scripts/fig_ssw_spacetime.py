@@ -1,12 +1,12 @@
-"""Figure ssw_spacetime: the SSW along the chain (chain.report.fig_ssw_spacetime)."""
+"""Figure ssw_spacetime: the SSW along the chain (chain.report.figures.fig_ssw_spacetime)."""
 
 from pathlib import Path
 
 import pandas as pd
 from _logging import start
 
-from chain.report.fig_ssw_spacetime import fig_ssw_spacetime
-from chain.report.style import save_figure
+from chain.report.figures.fig_ssw_spacetime import fig_ssw_spacetime
+from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 # One field file per chain, in the order of params.chains (long_chains: of long_fields).

@@ -1,8 +1,8 @@
-"""summary.md: the side-by-side table, written from summary.json (chain.report.summary_md)."""
+"""summary.md: the side-by-side table, written from summary.json (chain.report.text.markdown)."""
 
 from _logging import start
 
-from chain.report.summary_md import write_summary_markdown
+from chain.report.text.markdown import write_summary_markdown
 
 log = start(snakemake)
 write_summary_markdown(snakemake.input.json, snakemake.output.md)

@@ -114,31 +114,6 @@ SSW_COLUMNS = (
 _CROSSED = {"S2": ("LSTW", "S1"), "S1": ("RSTW", "S2")}
 
 
-def rescaled_template(time_s, reference_time_s, reference_force_N, scale, arrival_s, ref_arrival_s):
-    """A reference pulse turned into the solitary wave of ``scale`` times its force, N.
-
-    Hertz self-similarity: a solitary wave ``scale`` times stronger is ``scale^(-1/6)``
-    times shorter, F(t) = scale * F_ref(T_ref + (t - T) scale^(1/6)).
-
-    Parameters
-    ----------
-    time_s : array
-        Times at which to evaluate the template, s.
-    reference_time_s, reference_force_N : array
-        The reference signal (baseline removed), s and N.
-    scale : float
-        Force ratio a (template / reference).
-    arrival_s : float
-        Arrival time T of the template, s.
-    ref_arrival_s : float
-        Arrival time T_ref of the reference pulse, s.
-    """
-    from scipy.interpolate import CubicSpline  # imported here: see measure_ssw
-
-    spline = CubicSpline(reference_time_s, reference_force_N, extrapolate=False)
-    return _template(spline, np.asarray(time_s, dtype=float), scale, arrival_s, ref_arrival_s)
-
-
 def _template(spline, time, scale, arrival, ref_arrival):
     # Zero outside the reference record (the spline does not extrapolate).
     source = ref_arrival + (time - arrival) * scale ** (1.0 / 6.0)

@@ -27,6 +27,15 @@ PAPER_TIME_CONSTANT = 2.94
 #: The numerical prefactor printed in the second line of Eq. 6.
 PAPER_CBAL_PREFACTOR = 0.7612
 
+#: Contact time of two free beads over that of a bead against an immovable body, at the
+#: same approach speed: t_c grows as (mass)^(2/5), and two free beads collide with the
+#: reduced mass m/2 where Eq. 6 takes m.
+REDUCED_MASS_TIME_FACTOR = 2.0 ** (-0.4)
+
+#: The exact ballistic C over Eq. 6's (the reduced mass and the unrounded Hertz constant):
+#: C_bal_exact / C_bal as printed, for any beads.
+EXACT_OVER_PAPER_BALLISTIC = REDUCED_MASS_TIME_FACTOR * HERTZ_TIME_CONSTANT / PAPER_TIME_CONSTANT
+
 
 #: V_m / V0 of the solitary wave formed when bead 1 of a free chain is launched at V0
 #: (0.47 measured: F_m = 1030 N at 1 m/s in the paper's chains); a little lower, so that

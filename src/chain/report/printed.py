@@ -5,6 +5,7 @@ of ten, and tables of records whose columns are not known here."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 
 
@@ -86,12 +87,7 @@ def plus_minus(value, error, decimals: int | None = None, style: str = "text") -
     exponent = math.floor(math.log10(scale)) if scale > 0 else 0
     if not POWER_LIMITS[0] <= exponent < POWER_LIMITS[1]:
         body = plus_minus(value / 10.0**exponent, _scaled(error, exponent), None, style)
-        power = POWER_STYLES[style].format(
-            exponent=minus(str(exponent)),
-            superscript=minus(str(exponent)).translate(_SUPERSCRIPTS),
-            ascii=exponent,
-        )
-        return f"({body}) {power}" if "±" in body else f"{body} {power}"
+        return _with_power(f"({body})" if "±" in body else body, minus(str(exponent)), style)
     if has_error:
         places = error_decimals(float(error))
         return f"{_decimal_text(value, places)} ± {_decimal_text(float(error), places)}"
@@ -137,6 +133,67 @@ def scientific(value, significant: int = 2) -> dict | None:
     return {"mantissa": minus(mantissa), "exponent": minus(str(int(exponent)))}
 
 
+def power_of_ten(value, significant: int = 2, style: str = "text") -> str:
+    """``value`` as a reader writes a very small or large number: ``5.5 × 10^−10``,
+    never ``5.5e-10``; ``n/a`` for None or NaN, ``0`` for 0. The one home of that rule
+    (:func:`number` uses it where a plain number would need an exponent).
+
+    Parameters
+    ----------
+    value : float or None
+        The number, any unit.
+    significant : int
+        Significant digits of the mantissa.
+    style : {"text", "unicode", "mathtext"}
+        How the power of ten is written (:data:`POWER_STYLES`): ``× 10^−10`` for the
+        article (its typst source sets ``^`` as a superscript), ``× 10⁻¹⁰`` for
+        Markdown, mathtext for figures.
+    """
+    if not _finite(value):
+        return "n/a"
+    parts = scientific(value, significant)
+    if parts is None:
+        return "0"
+    return _with_power(parts["mantissa"], parts["exponent"], style)
+
+
+def _with_power(mantissa: str, exponent: str, style: str) -> str:
+    """``mantissa × 10^exponent`` in ``style`` (:data:`POWER_STYLES`); both printed."""
+    power = POWER_STYLES[style].format(
+        exponent=exponent,
+        superscript=exponent.translate(_SUPERSCRIPTS),
+        ascii=exponent.replace("\u2212", "-"),
+    )
+    return f"{mantissa} {power}"
+
+
+def number(value, significant: int = 4, style: str = "text") -> str:
+    """``value`` to ``significant`` digits as ``{:g}`` would print it, minus sign
+    U+2212, but with a power of ten (:func:`power_of_ten`) where ``{:g}`` would write
+    e-notation; ``n/a`` for None or NaN."""
+    if not _finite(value):
+        return "n/a"
+    text = f"{float(value):.{significant}g}"
+    if "e" not in text:
+        return minus(text)
+    mantissa, exponent = text.split("e")  # the digits {:g} keeps, trailing zeros dropped
+    return _with_power(minus(mantissa), minus(str(int(exponent))), style)
+
+
+#: A number in e-notation inside a text ("5.5e-10", "1e+03"); not part of a word or of a
+#: hexadecimal hash such as a commit's.
+E_NOTATION = re.compile(r"(?<![\w.])[+\-\u2212]?\d+(?:\.\d+)?[eE][+\-\u2212]?\d+(?![\w.])")
+
+
+def without_e_notation(text: str, style: str = "text") -> str:
+    """``text`` with every number in e-notation (:data:`E_NOTATION`) written with a
+    power of ten (:func:`number`, 4 significant digits): for texts made elsewhere, such
+    as a study's setting names ("gap_mean_m=1e-07" -> "gap_mean_m=1 × 10^−7")."""
+    return E_NOTATION.sub(
+        lambda match: number(float(match.group().replace("\u2212", "-")), 4, style), str(text)
+    )
+
+
 def percent(value: float, reference: float, decimals: int = 1) -> str:
     """Signed relative difference of ``value`` from ``reference``, in %."""
     return minus(f"{100.0 * (value / reference - 1.0):+.{decimals}f}") + " %"
@@ -151,8 +208,8 @@ def cell(value) -> str:
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
-        return "n/a" if not math.isfinite(value) else minus(f"{value:.4g}")
-    return str(value)
+        return number(value, 4)
+    return without_e_notation(str(value))
 
 
 def table_of(rows: Sequence[Mapping] | None) -> dict | None:

@@ -6,7 +6,7 @@ pulse is the incident LSTW and the second the crossed RSTW, at S2 the other way 
 the trace is split at the minimum between the two pulses. The reference shot (LSTW
 alone) is dotted. An inset zooms on what follows the crossed pulse, where the secondary
 solitary wave (SSW) arrives. Which shots and rows are drawn is chosen in
-:mod:`chain.report.picks`.
+:mod:`chain.report.figures.picks`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from chain.report import picks
-from chain.report.style import (
+from chain.report.figures import picks
+from chain.report.figures.style import (
     LSTW_COLOR,
     MICRO,
     REFERENCE_COLOR,
@@ -53,7 +53,7 @@ def trace_figure(
 ) -> Figure:
     """Fig. 2 or Fig. 3: the forces at S1 and S2 of one shot per chain.
 
-    Parameters as in :func:`chain.report.fig3_simulation_traces.fig3_simulation_traces`,
+    Parameters as in :func:`chain.report.figures.fig3_simulation_traces.fig3_simulation_traces`,
     and ``source`` (the rows drawn), ``title`` (the figure's title without the model)
     and ``selection`` (the acceptance protocol's table, or None).
     """
@@ -156,7 +156,7 @@ def draw_sensor(ax, collision, reference, sensor, bead, s2, pulses, ssw, estimat
     """One panel: the reference shot (dotted) and the collision shot split into its two
     waves at sensor ``sensor`` (bead ``bead``; ``s2`` is the S2 bead, whose reference
     pulse is the inset's template); returns the collision's pulse times at the sensor
-    (:func:`chain.report.picks.pulse_times`)."""
+    (:func:`chain.report.figures.picks.pulse_times`)."""
     column = sensor_column(bead)
     if reference is not None:
         ax.plot(

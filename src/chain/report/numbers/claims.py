@@ -4,7 +4,11 @@
 why not). A verdict is never typed: it compares our number with the paper's against the
 tolerances of :data:`TOLERANCES`, and says "not testable" where this run has nothing to
 compare (no measurements). The paper's numbers come from ``summary["paper"]``
-(:mod:`chain.report.paper`), quoted as printed.
+(:mod:`chain.report.numbers.paper`), quoted as printed.
+
+Every verdict is decided here, once, and written to ``summary.json`` (key ``verdicts``:
+the tolerances, the dissipation ratios of :func:`dissipation_verdicts` and the claim
+table of :func:`with_claims`); summary.md and the article read them.
 """
 
 from __future__ import annotations
@@ -16,8 +20,18 @@ import pandas as pd
 
 from chain.analysis.regression import fit_power_law, ratio_with_error
 from chain.analysis.rows import is_ok
-from chain.report.paper import PAPER_ENERGY_DRIFT
-from chain.report.printed import fixed, percent, plus_minus, plus_minus_stat_sys, scientific
+from chain.labels import VIRTUAL_LABEL
+from chain.report.naming import is_virtual, named
+from chain.report.numbers.mechanisms import friction_c_text
+from chain.report.numbers.paper import PAPER_ENERGY_DRIFT
+from chain.report.printed import (
+    fixed,
+    number,
+    percent,
+    plus_minus,
+    plus_minus_stat_sys,
+    power_of_ten,
+)
 
 #: When a number of ours "agrees" with the paper's claim. Relative for C, absolute for
 #: exponents; printed in the article beside the table.
@@ -65,15 +79,6 @@ def series_models(summary, source) -> list[str]:
     return list(dict.fromkeys(r["model"] for r in summary["delay_fits"] if r["source"] == source))
 
 
-def series_label(summary, source, model) -> str:
-    """How the article names a series: "simulation, elastic", or the experiment's label
-    ("virtual experiment (model)" for the model of the apparatus)."""
-    label = summary.get("experiment_label", "experiment")
-    if source == "experiment":
-        return label if model in label else f"{label}, {model}"
-    return f"simulation, {model}"
-
-
 def _verdict(ok: bool | None) -> str:
     return "not testable" if ok is None else ("yes" if ok else "no")
 
@@ -89,8 +94,9 @@ def loss_text(summary, model) -> str | None:
         return None
     row = max(rows, key=lambda r: 1 - r["ratio_high"])
     return (
-        f"a lone wave loses {100 * (1 - row['ratio_low']):.1f} % (at {row['F_S1_low_N']:.3g} N)"
-        f" to {100 * (1 - row['ratio_high']):.1f} % (at {row['F_S1_high_N']:.3g} N) of its "
+        f"a lone wave loses {100 * (1 - row['ratio_low']):.1f} % (at "
+        f"{number(row['F_S1_low_N'], 3)} N) to {100 * (1 - row['ratio_high']):.1f} % (at "
+        f"{number(row['F_S1_high_N'], 3)} N) of its "
         f"amplitude between S1 and S2 (N = {row['N']}), so the waves cross weaker than the "
         "F_m measured at S1, by a fraction that grows with F_m"
     )
@@ -105,7 +111,7 @@ def _early_claim(summary, delays: pd.DataFrame | None) -> list[dict]:
     parts, ok = [], True
     for (source, model), group in rows.groupby(["source", "model"], sort=False):
         early = int((group["delay_us"] < 0).sum())
-        parts.append(f"{series_label(summary, source, model)}: {early} of {len(group)}")
+        parts.append(f"{named(summary, source, model)}: {early} of {len(group)}")
         ok = ok and early == len(group)
     return [
         _claim(
@@ -136,7 +142,7 @@ def _exponent_claims(summary) -> list[dict]:
                 why = ablation.get("verdict") or f"cause {NOT_COMPUTED} (no ablation)"
             out.append(
                 _claim(
-                    f"|Δ| ∝ F_m^(−1/6), {series_label(summary, source, model)}",
+                    f"|Δ| ∝ F_m^(−1/6), {named(summary, source, model)}",
                     "−1/6 (Eq. 6; fits fix it)",
                     "free exponent " + plus_minus(row["exponent"], row["exponent_stderr"], 4),
                     ok,
@@ -179,7 +185,7 @@ def _c_claims(summary) -> list[dict]:
     paper = summary["paper"]
     c_exp, err = paper["C_exp_us_N16"], paper["C_exp_err_us_N16"]
     tolerance = TOLERANCES["C"]
-    label = summary.get("experiment_label", "experiment")
+    virtual = is_virtual(summary.get("experiment_label", "experiment"))
     out = []
     for source in ("experiment", "simulation"):
         for model in series_models(summary, source):
@@ -192,15 +198,15 @@ def _c_claims(summary) -> list[dict]:
                 claim = "C_exp, fit of the measured |Δ|"
                 why = (
                     "a model of the apparatus, not the paper's measurements"
-                    if ("virtual" in label)
+                    if virtual
                     else "a different set of measurements"
                 )
             else:
                 claim = "Simulations of Eq. 1 close to the measured Δ"
-                why = "no track friction or bead rotation modelled (the paper's explanation)"
+                why = _simulation_c_why(summary)
             out.append(
                 _claim(
-                    f"{claim} ({series_label(summary, source, model)})",
+                    f"{claim} ({named(summary, source, model)})",
                     f"C_exp = {c_exp:.1f} ± {err:.1f}",
                     f"C = {plus_minus(c, row['C_stderr_us_N16'], 2)} ({percent(c, c_exp)})",
                     ok,
@@ -208,6 +214,19 @@ def _c_claims(summary) -> list[dict]:
                 )
             )
     return out
+
+
+def _simulation_c_why(summary) -> str:
+    """Why a simulated C is not the measured one: the mechanism study's answer when the
+    run has it (track friction and bead rotation modelled, C with and without), else
+    the paper's explanation, which this run does not test."""
+    moved = friction_c_text(summary.get("ssw_mechanisms"))
+    if moved is None:
+        return "no track friction or bead rotation modelled (the paper's explanation)"
+    return (
+        "Eq. 1 has no track friction or bead rotation (the paper's explanation); the "
+        f"mechanism study models both: {moved}"
+    )
 
 
 def dissipation_pairs(summary):
@@ -225,22 +244,40 @@ def dissipation_pairs(summary):
             yield model, base, row, reference
 
 
-def _dissipation_claim(summary) -> list[dict]:
-    """Δ independent of viscoelastic dissipation: C(dissipative) / C(conservative)."""
+def dissipation_verdicts(summary) -> list[dict]:
+    """C of each dissipative model over C of each conservative one (chains pooled, main
+    estimator), and whether the ratio is 1 within ``TOLERANCES["dissipation_ratio"]``:
+    the paper's "dissipation does not change Δ" (Sec. V), decided here only.
+
+    Returns
+    -------
+    list of dict
+        ``model``, ``base`` (the conservative model), ``ratio`` (C / C_base) and
+        ``agrees`` (bool), per pair of :func:`dissipation_pairs`.
+    """
     out = []
     for model, base, row, reference in dissipation_pairs(summary):
         ratio = row["C_us_N16"] / reference["C_us_N16"]
         ok = abs(ratio - 1) <= TOLERANCES["dissipation_ratio"]
-        out.append(
-            _claim(
-                "Viscoelastic dissipation does not change Δ",
-                "C unchanged (Sec. V)",
-                f"C({model}) / C({base}) = {ratio:.3f}",
-                ok,
-                "" if ok else (loss_text(summary, model) or ""),
-            )
-        )
+        out.append({"model": model, "base": base, "ratio": ratio, "agrees": ok})
     return out
+
+
+def _dissipation_claim(summary) -> list[dict]:
+    """Δ independent of viscoelastic dissipation: C(dissipative) / C(conservative)."""
+    verdicts = (summary.get("verdicts") or {}).get("dissipation")
+    if verdicts is None:
+        verdicts = dissipation_verdicts(summary)
+    return [
+        _claim(
+            "Viscoelastic dissipation does not change Δ",
+            "C unchanged (Sec. V)",
+            f"C({v['model']}) / C({v['base']}) = {v['ratio']:.3f}",
+            v["agrees"],
+            "" if v["agrees"] else (loss_text(summary, v["model"]) or ""),
+        )
+        for v in verdicts
+    ]
 
 
 def _ssw_rows(ssw: pd.DataFrame | None) -> pd.DataFrame:
@@ -300,7 +337,7 @@ def _proportional_claim(summary, source, model, group, fits) -> dict:
         # The Hertz chain launched from its ends is self-similar (F ~ V0^(6/5)).
         parts.append("self-similar chain: the scatter is the sampling")
     return _claim(
-        f"SSW amplitude ∝ F_m ({series_label(summary, source, model)})",
+        f"SSW amplitude ∝ F_m ({named(summary, source, model)})",
         "proportional, no value",
         "; ".join(parts),
         (ok if tested else None),
@@ -323,9 +360,7 @@ def _parity_claim(summary, fits) -> list[dict]:
         ratio = ratio_with_error(
             even["slope"], even["slope_stderr"], odd["slope"], odd["slope_stderr"]
         )
-        parts.append(
-            f"at the sensors, {series_label(summary, source, model)}: {_ratio_text(ratio)}"
-        )
+        parts.append(f"at the sensors, {named(summary, source, model)}: {_ratio_text(ratio)}")
         decisive.append(ratio["ratio"] - 2 * ratio["ratio_err"] > 1)
         wrong.append(ratio["ratio"] < 1)
     for row in summary.get("ssw_far_field") or []:
@@ -377,8 +412,8 @@ def _experiment_claim(summary, fits) -> list[dict]:
                 f"(± {fixed(total['ratio_err'], 2)} total)"
             )
             excess.append(total["ratio"] - 2 * total["ratio_err"] > 1)
-    virtual = "virtual" in summary.get("experiment_label", "")
-    name = "virtual experiment (model)" if virtual else "measured"
+    virtual = is_virtual(summary.get("experiment_label", ""))
+    name = VIRTUAL_LABEL if virtual else "measured"
     if not parts:
         return [_claim("Simulated SSW much smaller than measured", "much smaller, no value",
                        NOT_COMPUTED, None, "no experiment SSW slope in this run")]  # fmt: skip
@@ -413,17 +448,22 @@ def _ssw_claims(summary, ssw: pd.DataFrame | None) -> list[dict]:
     return out + _parity_claim(summary, fits) + _experiment_claim(summary, fits)
 
 
+def energy_drift_within_paper(drift: float | None) -> bool | None:
+    """Whether the conservative runs' largest relative energy drift is within the
+    paper's order (:data:`PAPER_ENERGY_DRIFT`, Sec. II); None without any."""
+    return None if drift is None else bool(drift <= PAPER_ENERGY_DRIFT)
+
+
 def _drift_claim(summary) -> list[dict]:
     drift = summary.get("max_energy_drift")
-    number = scientific(drift)
-    ours = NOT_COMPUTED if number is None else (f"{number['mantissa']} × 10^{number['exponent']}")
+    ok = energy_drift_within_paper(drift)
     return [
         _claim(
             "Energy conserved by the integrator (conservative chain)",
-            f"~{PAPER_ENERGY_DRIFT:.0e}".replace("e-0", " × 10^−"),
-            ours,
-            None if drift is None else drift <= PAPER_ENERGY_DRIFT,
-            "" if drift is None or drift <= PAPER_ENERGY_DRIFT else "larger drift",
+            f"~{power_of_ten(PAPER_ENERGY_DRIFT, 1)}",
+            NOT_COMPUTED if drift is None else power_of_ten(drift),
+            ok,
+            "" if ok in (None, True) else "larger drift",
         )
     ]
 
@@ -453,3 +493,21 @@ def claims(summary: Mapping, delays=None, ssw=None) -> list[dict]:
         *_ssw_claims(summary, ssw),
         *_drift_claim(summary),
     ]
+
+
+def with_claims(summary: Mapping, delays=None, ssw=None) -> dict:
+    """``summary`` with its claim table decided: ``verdicts["claims"]`` is
+    :func:`claims` of it. Called last, when the summary holds the studies (ablation,
+    mechanisms) whose findings answer a claim's "why not".
+
+    Parameters
+    ----------
+    summary : mapping
+        The run's ``summary.json`` contents (``build_summary`` of
+        :mod:`chain.report.numbers.summary`, and the study entries).
+    delays, ssw : DataFrame, optional
+        ``delays.csv`` and ``ssw.csv``.
+    """
+    verdicts = dict(summary.get("verdicts") or {})
+    verdicts["claims"] = claims(summary, delays, ssw)
+    return {**summary, "verdicts": verdicts}

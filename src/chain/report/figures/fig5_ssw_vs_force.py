@@ -21,16 +21,16 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
-from chain.report import picks
-from chain.report.printed import plus_minus_stat_sys
-from chain.report.style import (
+from chain.report.figures import picks
+from chain.report.figures.style import (
     STYLE,
     chain_marker,
     model_colors,
     new_figure,
     plain_numbers,
-    source_label,
 )
+from chain.report.naming import series_name
+from chain.report.printed import plus_minus_stat_sys
 
 #: Length of an upper-limit arrow, as a fraction of the drawn value (log axis).
 ARROW_FRACTION = 0.35
@@ -177,8 +177,7 @@ def _series_style(source, model, n, colors, all_n, experiment_label) -> tuple[di
     if marker == "x":
         marker = "s"  # a cross cannot be filled
     color = colors.get(model, "black") if source == "simulation" else "black"
-    name = source_label(source, experiment_label)
-    label = f"{name}, {model}, N = {n}" if source == "simulation" else f"{name}, N = {n}"
+    label = series_name(source, model, experiment_label, n)
     return {"marker": marker, "color": color}, label
 
 

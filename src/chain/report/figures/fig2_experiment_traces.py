@@ -1,6 +1,6 @@
 """Fig. 2: experiment forces at the sensor beads, (A, B) N = 25, (C, D) N = 26.
 
-The panels are those of Fig. 3 (:mod:`chain.report.trace_panels`), drawn from the
+The panels are those of Fig. 3 (:mod:`chain.report.figures.trace_panels`), drawn from the
 experiment's trace tables (virtual or measured) and showing a collision shot that the
 acceptance protocol kept.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 import pandas as pd
 from matplotlib.figure import Figure
 
-from chain.report.trace_panels import trace_figure
+from chain.report.figures.trace_panels import trace_figure
 
 
 def fig2_experiment_traces(
@@ -29,7 +29,7 @@ def fig2_experiment_traces(
     """Fig. 2: experiment forces at S1 and S2, (A, B) N = 25, (C, D) N = 26.
 
     Same layout and notation as
-    :func:`chain.report.fig3_simulation_traces.fig3_simulation_traces`; ``traces`` are
+    :func:`chain.report.figures.fig3_simulation_traces.fig3_simulation_traces`; ``traces`` are
     experiment trace tables (``source == "experiment"``, virtual or measured), and
     ``label`` names them (``"virtual experiment (model)"`` for the model of the
     apparatus). Parameters as in Fig. 3, and:

@@ -4,7 +4,7 @@ Every number is computed from the run's tables and the closed forms of
 :mod:`chain.physics.theory`, except the paper's own values in :data:`PAPER`, quoted as
 printed. :func:`build_summary` gathers them into a JSON-ready dict, :func:`summary_json`
 writes it with sorted keys and fixed float formatting, and :func:`write_summary_json`
-writes ``summary.json`` atomically; :mod:`chain.report.summary_md` writes the Markdown from it.
+writes ``summary.json`` atomically; :mod:`chain.report.text.markdown` writes the Markdown from it.
 """
 
 from __future__ import annotations
@@ -23,8 +23,20 @@ from chain.analysis.selection import selection_counts, skipped_shots
 from chain.analysis.ssw_fits import ssw_parity_table, ssw_resolution_table
 from chain.analysis.ssw_speed import far_field_parity, separation_table
 from chain.atomic import write_text_atomic
-from chain.physics.theory import ballistic_constants
-from chain.report.paper import PAPER
+from chain.physics.theory import (
+    EXACT_OVER_PAPER_BALLISTIC,
+    HERTZ_TIME_CONSTANT,
+    PAPER_TIME_CONSTANT,
+    REDUCED_MASS_TIME_FACTOR,
+    ballistic_constants,
+)
+from chain.report.naming import series_names
+from chain.report.numbers.claims import (
+    TOLERANCES,
+    dissipation_verdicts,
+    energy_drift_within_paper,
+)
+from chain.report.numbers.paper import PAPER, PAPER_BEADS
 
 #: Significant digits of floats in summary.json.
 JSON_DIGITS = 10
@@ -140,33 +152,76 @@ def build_summary(
         }
         drifts = [v for k, v in drift_by_model.items() if k in conservative]
         max_drift = max(drifts) if drifts else None
-    return _number(
-        {
-            "run_name": run_name,
-            "material": material,
-            "radius_m": radius_m,
-            "main_estimator": main_estimator,
-            "experiment_label": experiment_label,
-            "conservative_models": sorted(conservative),
-            "constants": ballistic_constants(material, radius_m),
-            "paper": dict(PAPER),
-            "max_energy_drift": max_drift,
-            "energy_drift_by_model": drift_by_model,
-            "delay_fits": _records(delay_fits),
-            "ssw_fits": _records(ssw_fits),
-            "flagged": {
-                "pulses": flag_counts(pulses, ["F_m_N", "T_s"]),
-                "delays": flag_counts(delays, ["F_m_N", "delay_us"]),
-                "ssw": flag_counts(_residual_rows(ssw), ["F_m_N", "ssw_N"]),
-            },
-            "selection": selection_counts(selection),
-            "experiment_tolerance": tolerance,
-            "attenuation": attenuation_rows(pulses, main_estimator),
-            **ssw_summary(ssw, ssw_fits, ssw_speed),
-            # Only when shots were skipped, so that runs without any keep their bytes.
-            **({"skipped_shots": skipped} if (skipped := skipped_shots(selection)) else {}),
-        }
+    summary = {
+        "run_name": run_name,
+        "material": material,
+        "radius_m": radius_m,
+        "main_estimator": main_estimator,
+        "experiment_label": experiment_label,
+        "conservative_models": sorted(conservative),
+        "constants": ballistic_constants(material, radius_m),
+        "paper": dict(PAPER),
+        "max_energy_drift": max_drift,
+        "energy_drift_by_model": drift_by_model,
+        "delay_fits": _records(delay_fits),
+        "ssw_fits": _records(ssw_fits),
+        "flagged": {
+            "pulses": flag_counts(pulses, ["F_m_N", "T_s"]),
+            "delays": flag_counts(delays, ["F_m_N", "delay_us"]),
+            "ssw": flag_counts(_residual_rows(ssw), ["F_m_N", "ssw_N"]),
+        },
+        "selection": selection_counts(selection),
+        "experiment_tolerance": tolerance,
+        "attenuation": attenuation_rows(pulses, main_estimator),
+        **ssw_summary(ssw, ssw_fits, ssw_speed),
+        # Only when shots were skipped, so that runs without any keep their bytes.
+        **({"skipped_shots": skipped} if (skipped := skipped_shots(selection)) else {}),
+    }
+    return _number({**summary, **decisions(summary)})
+
+
+def decisions(summary: Mapping) -> dict:
+    """What the report decides about the run's numbers, once, for summary.md, the
+    article and the figures to print (they never decide again).
+
+    Parameters
+    ----------
+    summary : mapping
+        The summary so far (:func:`build_summary`'s keys).
+
+    Returns
+    -------
+    dict
+        ``series_names`` (``{source: {model: name}}``, :mod:`chain.report.naming`),
+        ``paper_beads`` (the paper's ``material`` and ``radius_m``, and ``same``: whether
+        the run's beads are they, so that the paper's numbers compare),
+        ``ballistic_factors`` (Eq. 6's contact time against the exact one:
+        ``reduced_mass_time_factor``, ``hertz_time_constant``, ``paper_time_constant``
+        and their product ``exact_over_paper``, :mod:`chain.physics.theory`) and
+        ``verdicts``: the ``tolerances`` of :data:`chain.report.numbers.claims.TOLERANCES`,
+        ``dissipation`` (:func:`chain.report.numbers.claims.dissipation_verdicts`) and
+        ``energy_drift_within_paper``. The claim table joins ``verdicts`` last
+        (:func:`chain.report.numbers.claims.with_claims`).
+    """
+    series = [(r["source"], r["model"]) for r in [*summary["delay_fits"], *summary["ssw_fits"]]]
+    same = summary["material"] == PAPER_BEADS["material"] and math.isclose(
+        summary["radius_m"], PAPER_BEADS["radius_m"], rel_tol=1e-9
     )
+    return {
+        "series_names": series_names(series, summary["experiment_label"]),
+        "paper_beads": {**PAPER_BEADS, "same": same},
+        "ballistic_factors": {
+            "reduced_mass_time_factor": REDUCED_MASS_TIME_FACTOR,
+            "hertz_time_constant": HERTZ_TIME_CONSTANT,
+            "paper_time_constant": PAPER_TIME_CONSTANT,
+            "exact_over_paper": EXACT_OVER_PAPER_BALLISTIC,
+        },
+        "verdicts": {
+            "tolerances": dict(TOLERANCES),
+            "dissipation": dissipation_verdicts(summary),
+            "energy_drift_within_paper": energy_drift_within_paper(summary["max_energy_drift"]),
+        },
+    }
 
 
 def ssw_summary(
@@ -272,7 +327,7 @@ def _residual_rows(ssw: pd.DataFrame | None) -> pd.DataFrame | None:
 def write_summary_json(summary: Mapping, json_path: str | os.PathLike) -> None:
     """Write ``summary.json`` atomically (temporary name, then rename), sorted keys and
     floats to :data:`JSON_DIGITS` digits; ``summary.md`` is written from it by
-    :func:`chain.report.summary_md.write_summary_markdown`.
+    :func:`chain.report.text.markdown.write_summary_markdown`.
 
     Parameters
     ----------

@@ -63,6 +63,56 @@ def friction_sentence(table: pd.DataFrame, mechanism: str) -> str:
     )
 
 
+def friction_c_rows(table: pd.DataFrame, mechanism: str) -> list[dict]:
+    """C with track and bead friction beside the frictionless C, per chain and setting.
+
+    Returns
+    -------
+    list of dict
+        ``N``, ``setting``, ``C_frictionless`` and ``C`` (µs N^(1/6), None where not
+        fitted), for each frictional row of ``mechanism`` (the first setting of a
+        mechanism is its frictionless reference, as in :func:`friction_sentence`).
+    """
+    rows = table[table["mechanism"] == mechanism]
+    if rows.empty:
+        return []
+    reference = rows[rows["setting"] == rows["setting"].iloc[0]]
+    out = []
+    for row in rows.drop(index=reference.index).itertuples(index=False):
+        c0 = _c_of(reference, row.N)
+        out.append(
+            {
+                "N": int(row.N),
+                "setting": str(row.setting),
+                "C_frictionless": c0 if math.isfinite(c0) else None,
+                "C": float(row.C) if math.isfinite(float(row.C)) else None,
+            }
+        )
+    return out
+
+
+def friction_c_text(study: Mapping | None) -> str | None:
+    """How track and bead friction move C, per chain, from the summary key
+    ``ssw_mechanisms`` ("N = 25: C 44.2 -> 45.1-49.8 µs N^(1/6); ... (LAMMPS; settings)"), or
+    None when the run has no friction rows."""
+    rows = [
+        r
+        for r in (study or {}).get("friction_C") or []
+        if r.get("C") is not None and r.get("C_frictionless") is not None
+    ]
+    if not rows:
+        return None
+    parts = []
+    for n in sorted({r["N"] for r in rows}):
+        chain = [r["C"] for r in rows if r["N"] == n]
+        low, high = min(chain), max(chain)
+        moved = f"{low:.1f}" if f"{low:.1f}" == f"{high:.1f}" else f"{low:.1f}-{high:.1f}"
+        c0 = next(r["C_frictionless"] for r in rows if r["N"] == n)
+        parts.append(f"N = {n}: C {c0:.1f} -> {moved} µs N^(1/6)")
+    settings = "; ".join(dict.fromkeys(r["setting"] for r in rows))
+    return f"{'; '.join(parts)} (LAMMPS; {settings})"
+
+
 def candidate_sentence(table: pd.DataFrame, friction: str, reference: str) -> str:
     """The second sentence: the candidate whose SSW/F_m ratio, averaged over the chains,
     is largest, its C and its even/odd contrast, each against its own reference: the
@@ -115,7 +165,8 @@ def mechanism_summary(
     friction: str,
     reference: str,
 ) -> dict:
-    """``{"verdict": two sentences, "rows": the table, "lammps_check": its rows}``.
+    """``{"verdict": two sentences, "rows": the table, "lammps_check": its rows,
+    "friction_C": C with and without friction}`` (:func:`friction_c_rows`).
 
     Parameters
     ----------
@@ -131,23 +182,9 @@ def mechanism_summary(
     verdict = (
         f"{friction_sentence(table, friction)}. {candidate_sentence(table, friction, reference)}."
     )
-    return {"verdict": verdict, "rows": _records(table), "lammps_check": _records(check)}
-
-
-def mechanism_markdown(summary: Mapping) -> list[str]:
-    """Lines of ``summary.md`` for the mechanism study (none without it)."""
-    study = summary.get("ssw_mechanisms")
-    if not study:
-        return []
-    lines = ["", "## Why are the measured SSW larger? (models, not data)", "", study["verdict"]]
-    checks = study.get("lammps_check") or []
-    if checks:
-        worst_c = max(float(r["rel_diff_C"]) for r in checks)
-        worst_trace = max(float(r["max_trace_diff_over_Fm"]) for r in checks)
-        lines += [
-            "",
-            f"LAMMPS against our kernel in the frictionless 1D limit ({len(checks)} chain x "
-            f"model cases): C within {worst_c:.1e} relative, sensor traces within "
-            f"{worst_trace:.1e} F_m (tables/lammps_check.csv).",
-        ]
-    return lines
+    return {
+        "verdict": verdict,
+        "rows": _records(table),
+        "lammps_check": _records(check),
+        "friction_C": friction_c_rows(table, friction),
+    }

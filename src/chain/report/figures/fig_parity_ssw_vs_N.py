@@ -7,15 +7,15 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
-from chain.report import picks
-from chain.report.style import (
+from chain.report.figures import picks
+from chain.report.figures.style import (
     STYLE,
     add_legend,
     axes_or_new,
     draw_even_odd,
     model_colors,
-    source_label,
 )
+from chain.report.naming import series_name
 
 
 def fig_parity_ssw_vs_N(
@@ -48,7 +48,7 @@ def fig_parity_ssw_vs_N(
         for (source, model), group in rows.groupby(["source", "model"], sort=False):
             group = group.sort_values("N")
             color = colors.get(model, "black") if source == "simulation" else "black"
-            name = f"{source_label(source, experiment_label)}, {model}"
+            name = series_name(source, model, experiment_label)
             draw_even_odd(ax, group["N"], group["slope"], group["slope_stderr"], color, name)
         ax.set_xlabel("number of beads N")
         ax.set_ylabel("SSW amplitude / incident amplitude")

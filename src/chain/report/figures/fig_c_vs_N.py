@@ -4,7 +4,7 @@ Drawn from ``tables/sweep.csv`` (:func:`chain.studies.sweep.sweep_table`), one
 colour per contact model (eta), even chains (the waves meet at a contact) filled, odd
 chains (at a bead) open, error bars one standard error; the paper's measured C
 (N = 25, 26) as a grey band for scale. Its companion, the SSW slope against N, is
-:func:`chain.report.fig_parity_ssw_vs_N.fig_parity_ssw_vs_N`.
+:func:`chain.report.figures.fig_parity_ssw_vs_N.fig_parity_ssw_vs_N`.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import matplotlib as mpl
 import pandas as pd
 from matplotlib.figure import Figure
 
-from chain.report.paper import PAPER
-from chain.report.style import STYLE, draw_even_odd, model_colors
+from chain.report.figures.style import STYLE, draw_even_odd, model_colors
+from chain.report.numbers.paper import PAPER
 
 
 def fig_c_vs_N(sweep: pd.DataFrame, *, ax=None) -> Figure:

@@ -10,10 +10,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
-from chain.report import picks
-from chain.report.paper import PAPER
-from chain.report.printed import plus_minus
-from chain.report.style import (
+from chain.report.figures import picks
+from chain.report.figures.style import (
     STYLE,
     add_legend,
     axes_or_new,
@@ -23,6 +21,9 @@ from chain.report.style import (
     plain_numbers,
     us_n16,
 )
+from chain.report.naming import series_name
+from chain.report.numbers.paper import PAPER
+from chain.report.printed import plus_minus
 
 
 def fig4_delay_vs_force(
@@ -111,10 +112,8 @@ def _plot_experiment(ax, experiment, all_n, per_chain, experiment_label) -> tupl
     """Open black markers per series and chain, the chain's own fit in the legend.
     Returns the range of F_m drawn, N."""
     low, high = np.inf, -np.inf
-    several = experiment["model"].nunique() > 1
     for (model, n), group in experiment.groupby(["model", "N"], sort=True):
-        label = f"{experiment_label}, {model}" if several else experiment_label
-        label += f", N = {int(n)}"
+        label = series_name("experiment", model, experiment_label, int(n))
         if (model, int(n)) in per_chain:
             c, err = per_chain[(model, int(n))]
             label += f" (own fit C = {plus_minus(c, err, 1, style='mathtext')})"
@@ -137,11 +136,8 @@ def _plot_experiment(ax, experiment, all_n, per_chain, experiment_label) -> tupl
 def _plot_fits(ax, grid, pooled, colors, experiment_label) -> None:
     """The pooled fits Delta = C F_m^(-1/6), dashed, with C in the legend."""
     for fit in pooled:
-        who = (
-            f"fit to {experiment_label}, N pooled"
-            if fit.source == "experiment"
-            else f"fit to simulation, {fit.model}"
-        )
+        who = f"fit to {series_name(fit.source, fit.model, experiment_label)}"
+        who += ", N pooled" if fit.source == "experiment" else ""
         color = "black" if fit.source == "experiment" else colors.get(fit.model, "grey")
         ax.plot(
             grid,

@@ -10,7 +10,7 @@ import matplotlib as mpl
 import pandas as pd
 from matplotlib.figure import Figure
 
-from chain.report.style import STYLE, add_legend, axes_or_new, chain_marker
+from chain.report.figures.style import STYLE, add_legend, axes_or_new, chain_marker
 
 #: Percent per unit ratio.
 PERCENT = 100.0

@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, FancyArrowPatch, FancyBboxPatch, Rectangle
 
-from chain.report.style import LSTW_COLOR, RSTW_COLOR, STYLE, new_figure
+from chain.report.figures.style import LSTW_COLOR, RSTW_COLOR, STYLE, new_figure
 
 #: Colours of the drawing.
 TRACK_COLOR, TRACK_TEXT_COLOR = "#cfe3ef", "#4a6f86"

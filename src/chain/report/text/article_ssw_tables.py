@@ -2,10 +2,10 @@
 along the chain, and the even / odd ratios at the sensors and far from the collision.
 
 Each table is ``{"columns", "rows"}`` of printed cells, like
-:mod:`chain.report.article_tables`: a "Series" column named as the rest of the article
+:mod:`chain.report.text.article_tables`: a "Series" column named as the rest of the article
 names it, chosen columns with units, value ± error by
 :func:`chain.report.printed.plus_minus`. The summary keys they read are those of
-:func:`chain.report.summary.ssw_summary`; the CSVs stay the data.
+:func:`chain.report.numbers.summary.ssw_summary`; the CSVs stay the data.
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 
-from chain.report.claims import series_label
-from chain.report.printed import plus_minus
+from chain.report.naming import named
+from chain.report.printed import plus_minus, power_of_ten
 
 #: The section of the article that discusses each figure.
 FIGURE_SECTIONS = {
@@ -76,7 +76,7 @@ def _pooled_c(summary: Mapping) -> str:
         if r["N"] == "pooled" and r["estimator"] == summary.get("main_estimator")
     ]
     return "; ".join(
-        f"{series_label(summary, r['source'], r['model'])} "
+        f"{named(summary, r['source'], r['model'])} "
         f"{plus_minus(r.get('C_us_N16'), r.get('C_stderr_us_N16'))}"
         for r in rows
     )
@@ -86,7 +86,7 @@ def _slopes(summary: Mapping) -> str:
     """'simulation, elastic, N = 25: 0.0123 ± 0.0004; ...' of the SSW fits that gave a
     slope ('' for none)."""
     return "; ".join(
-        f"{series_label(summary, r['source'], r['model'])}, N = {r['N']}: "
+        f"{named(summary, r['source'], r['model'])}, N = {r['N']}: "
         f"{plus_minus(r.get('slope'), r.get('slope_stderr'))}"
         for r in summary.get("ssw_fits") or []
         if r.get("slope") is not None and math.isfinite(float(r["slope"]))
@@ -120,7 +120,7 @@ def _numbers_slopes(summary: Mapping) -> str:
 
 def _numbers_drift(summary: Mapping) -> str | None:
     drift = summary.get("max_energy_drift")
-    return None if drift is None else f"Largest relative energy drift {drift:.1e}."
+    return None if drift is None else f"Largest relative energy drift {power_of_ten(drift)}."
 
 
 def _numbers_chains(summary: Mapping) -> str | None:

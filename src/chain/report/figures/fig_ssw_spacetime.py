@@ -22,7 +22,7 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from chain.analysis.ssw_track import TRACK_FLOOR
-from chain.report.style import (
+from chain.report.figures.style import (
     LSTW_COLOR,
     RSTW_COLOR,
     STYLE,
@@ -82,7 +82,7 @@ def draw_waves(ax, track: pd.DataFrame) -> None:
         )
 
 
-def draw_ssw_vs_distance(ax, series: list[dict]) -> None:
+def _draw_separated_ssw(ax, series: list[dict]) -> None:
     """SSW / F_m against distance from the collision point, one entry per series
     (``label``, ``distance``, ``ratio``, ``marker``, ``color``, ``filled``); a series
     without points gets a legend entry only."""
@@ -163,7 +163,7 @@ def fig_ssw_spacetime(
                 ax = fig.add_subplot(grid[row, column])
                 mesh = _field_panel(ax, n, field, track, model)
         side = fig.add_subplot(grid[0, columns])
-        draw_ssw_vs_distance(side, ssw_series(track))
+        _draw_separated_ssw(side, ssw_series(track))
         side.set_title("SSW where separated (all shots)", loc="left")
         if mesh is not None:
             fig.colorbar(mesh, ax=fig.axes[:-1], label="contact force / F$_m$", shrink=0.8)

@@ -173,11 +173,6 @@ def chain_marker(n: int, order: Sequence[int] = ()) -> str:
     return _EXTRA_MARKERS[index % len(_EXTRA_MARKERS)]
 
 
-def source_label(source: str, experiment_label: str) -> str:
-    """Name of a table's ``source`` in legends: ``experiment_label`` for experiment rows."""
-    return experiment_label if source == "experiment" else "simulation"
-
-
 def us_n16(value: float) -> str:
     """A constant C in µs N^(1/6), for legends."""
     return f"{value:.2f} µs N$^{{1/6}}$"

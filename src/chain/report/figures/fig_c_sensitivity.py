@@ -8,7 +8,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from chain.analysis.rows import is_ok
-from chain.report.style import STYLE, add_legend, axes_or_new, chain_marker
+from chain.report.figures.style import STYLE, add_legend, axes_or_new, chain_marker
 
 #: Group titles of the choices.
 _CHOICE_NAMES = {

@@ -8,7 +8,7 @@ against the tolerances of :data:`TOLERANCES`, and the findings of the SSW and ab
 studies (``None`` when the run did not compute them: the article then says so).
 :func:`compile_article` compiles the source with the ``typst`` package from PyPI.
 
-The paper's own numbers come from :mod:`chain.report.paper` via ``summary["paper"]``
+The paper's own numbers come from :mod:`chain.report.numbers.paper` via ``summary["paper"]``
 and are always printed as the paper's.
 """
 
@@ -20,29 +20,15 @@ import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
-import pandas as pd
-
 from chain.atomic import atomic_output
-from chain.physics.theory import HERTZ_TIME_CONSTANT, PAPER_TIME_CONSTANT
-from chain.report.article_figures import CAPTIONS, figure_text
-from chain.report.article_ssw_tables import (
-    far_field_table,
-    parity_table,
-    resolution_table,
-    separation_table,
-)
-from chain.report.article_tables import ablation_tables, c_spread_tables
-from chain.report.claims import (
+from chain.report.naming import is_virtual, named
+from chain.report.numbers.claims import (
     NOT_COMPUTED,
-    TOLERANCES,
-    claims,
-    dissipation_pairs,
     fit_row,
     loss_text,
-    series_label,
     series_models,
 )
-from chain.report.paper import PAPER_ENERGY_DRIFT
+from chain.report.numbers.paper import PAPER_ENERGY_DRIFT
 from chain.report.printed import (
     fixed,
     percent,
@@ -50,7 +36,16 @@ from chain.report.printed import (
     plus_minus_stat_sys,
     scientific,
     table_of,
+    without_e_notation,
 )
+from chain.report.text.article_figures import CAPTIONS, figure_text
+from chain.report.text.article_ssw_tables import (
+    far_field_table,
+    parity_table,
+    resolution_table,
+    separation_table,
+)
+from chain.report.text.article_tables import ablation_tables, c_spread_tables
 
 
 def fit_rows(summary: Mapping) -> list[dict]:
@@ -70,7 +65,7 @@ def fit_rows(summary: Mapping) -> list[dict]:
     )
     return [
         {
-            "series": series_label(summary, r["source"], r["model"]),
+            "series": named(summary, r["source"], r["model"]),
             "N": "pooled" if r["N"] == "pooled" else str(r["N"]),
             "estimator": r["estimator"],
             "C": plus_minus(r.get("C_us_N16"), r.get("C_stderr_us_N16"), 2),
@@ -86,7 +81,7 @@ def ssw_slope_rows(summary: Mapping) -> list[dict]:
     decimals; ± total where a table has no split), points (resolved)."""
     return [
         {
-            "series": series_label(summary, r["source"], r["model"]),
+            "series": named(summary, r["source"], r["model"]),
             "N": str(r["N"]),
             "slope": _slope_text(r),
             "points": str(r.get("n_points", ""))
@@ -114,7 +109,7 @@ def findings(summary: Mapping) -> dict:
     resolved = summary.get("ssw_resolved") or None
 
     def label(source: str, model: str) -> str:
-        return series_label(summary, source, model)
+        return named(summary, source, model)
 
     ablation = summary.get("ablation") or None
     study = summary.get("ssw_mechanisms") or None
@@ -139,7 +134,7 @@ def findings(summary: Mapping) -> dict:
         "mechanisms": None
         if study is None
         else {
-            "verdict": str(study.get("verdict", "")),
+            "verdict": without_e_notation(study.get("verdict", "")),
             "table": table_of(study.get("rows")),
             "check": table_of(_check_rows(study.get("lammps_check"))),
         },
@@ -198,7 +193,7 @@ def _model_numbers(summary) -> list[dict]:
                 {
                     "source": source,
                     "model": model,
-                    "who": series_label(summary, source, model),
+                    "who": named(summary, source, model),
                     "C": plus_minus(main["C_us_N16"], main["C_stderr_us_N16"], 2),
                     "exponent": plus_minus(main.get("exponent"), main.get("exponent_stderr"), 4),
                     "per_N": per_n,
@@ -224,20 +219,27 @@ def _selection_text(summary) -> str | None:
 
 
 def _dissipation_numbers(summary) -> list[dict]:
-    """C and exponent of each dissipative model against each conservative one (pooled)."""
-    return [
-        {
-            "model": model,
-            "base": base,
-            "ratio": f"{row['C_us_N16'] / reference['C_us_N16']:.3f}",
-            "exponent": fixed(row.get("exponent"), 4),
-            "base_exponent": fixed(reference.get("exponent"), 4),
-            "loss": loss_text(summary, model),
-            "larger": row["C_us_N16"] > reference["C_us_N16"],
-            "flatter": (row.get("exponent") or -math.inf) > (reference.get("exponent") or math.inf),
-        }
-        for model, base, row, reference in dissipation_pairs(summary)
-    ]
+    """C and exponent of each dissipative model against each conservative one (pooled),
+    the ratio as ``summary["verdicts"]["dissipation"]`` decided it."""
+    out = []
+    for verdict in summary["verdicts"]["dissipation"]:
+        model, base = verdict["model"], verdict["base"]
+        row = fit_row(summary, "simulation", model, "pooled")
+        reference = fit_row(summary, "simulation", base, "pooled")
+        out.append(
+            {
+                "model": model,
+                "base": base,
+                "ratio": f"{verdict['ratio']:.3f}",
+                "exponent": fixed(row.get("exponent"), 4),
+                "base_exponent": fixed(reference.get("exponent"), 4),
+                "loss": loss_text(summary, model),
+                "larger": verdict["ratio"] > 1,
+                "flatter": (row.get("exponent") or -math.inf)
+                > (reference.get("exponent") or math.inf),
+            }
+        )
+    return out
 
 
 def _between_ballistic(summary) -> bool:
@@ -262,6 +264,7 @@ def _constants_text(summary) -> dict:
     drift = scientific(summary.get("max_energy_drift"))
     c_paper, c_exact = constants["C_bal_paper_us_N16"], constants["C_bal_exact_us_N16"]
     kappa = scientific(constants["kappa_N_m1_5"], 4)
+    factors, tolerances = summary["ballistic_factors"], summary["verdicts"]["tolerances"]
     return {
         "run_name": summary["run_name"],
         "material": summary["material"],
@@ -270,7 +273,7 @@ def _constants_text(summary) -> dict:
         "mass_g": f"{constants['bead_mass_kg'] * 1e3:.1f}",
         "estimator": summary["main_estimator"],
         "experiment_label": summary.get("experiment_label", "experiment"),
-        "virtual": "virtual" in summary.get("experiment_label", ""),
+        "virtual": is_virtual(summary.get("experiment_label", "")),
         "has_experiment": bool(series_models(summary, "experiment")),
         "C_bal_printed": f"{paper['C_bal_us_N16']:.2f}",
         "C_bal_recomputed": f"{constants['C_bal_paper_us_N16']:.2f}",
@@ -279,18 +282,18 @@ def _constants_text(summary) -> dict:
         "ballistic_gap": f"{abs(100 * (c_paper / c_exact - 1)):.0f} %",
         "simulation_between_ballistic": _between_ballistic(summary),
         "paper_drift": scientific(PAPER_ENERGY_DRIFT, 1),
-        "mass_factor": f"{2.0**-0.4:.3f}",
-        "time_constant": f"{HERTZ_TIME_CONSTANT:.3f}",
-        "paper_time_constant": f"{PAPER_TIME_CONSTANT:.2f}",
+        "mass_factor": f"{factors['reduced_mass_time_factor']:.3f}",
+        "time_constant": f"{factors['hertz_time_constant']:.3f}",
+        "paper_time_constant": f"{factors['paper_time_constant']:.2f}",
         "C_exp": f"{paper['C_exp_us_N16']:.1f} ± {paper['C_exp_err_us_N16']:.1f}",
         "drift": drift,
         "selection": _selection_text(summary),
         "tolerances": {
-            "C": f"{100 * TOLERANCES['C']:g} %",
-            "C_bal_recomputed": f"{100 * TOLERANCES['C_bal_recomputed']:g} %",
-            "delay_exponent": f"{TOLERANCES['delay_exponent']:g}",
-            "dissipation_ratio": f"{100 * TOLERANCES['dissipation_ratio']:g} %",
-            "ssw_exponent": f"{TOLERANCES['ssw_exponent']:g}",
+            "C": f"{100 * tolerances['C']:g} %",
+            "C_bal_recomputed": f"{100 * tolerances['C_bal_recomputed']:g} %",
+            "delay_exponent": f"{tolerances['delay_exponent']:g}",
+            "dissipation_ratio": f"{100 * tolerances['dissipation_ratio']:g} %",
+            "ssw_exponent": f"{tolerances['ssw_exponent']:g}",
         },
     }
 
@@ -339,8 +342,6 @@ def setup_text(setup: Mapping | None) -> dict:
 
 def article_numbers(
     summary: Mapping,
-    delays: pd.DataFrame | None = None,
-    ssw: pd.DataFrame | None = None,
     setup: Mapping | None = None,
     provenance: Mapping | None = None,
 ) -> dict:
@@ -349,9 +350,9 @@ def article_numbers(
     Parameters
     ----------
     summary : mapping
-        The run's ``summary.json``.
-    delays, ssw : DataFrame, optional
-        ``delays.csv`` and ``ssw.csv`` of the run.
+        The run's ``summary.json``, with its decisions (``series_names``,
+        ``ballistic_factors``, ``verdicts`` with the claim table: :func:`chain.report.
+        numbers.claims.with_claims`).
     setup : mapping, optional
         Plain configuration values: ``chains`` (N, sensors), ``models`` (name, eta_s in
         s), ``launch`` (count, v0_min_m_s, v0_max_m_s in m/s), ``source`` (experiment
@@ -368,15 +369,20 @@ def article_numbers(
         pooled C, exponent, per-N C, estimator spread, attenuation), ``claims``,
         ``fits`` and ``ssw_slopes`` (every row, printed), ``findings`` (SSW, ablation,
         C spread; None where not computed), ``figure_text`` (section, caption and
-        paragraph per known figure, :mod:`chain.report.article_figures`),
+        paragraph per known figure, :mod:`chain.report.text.article_figures`),
         ``provenance`` and ``not_computed`` (the phrase for those).
     """
+    if "claims" not in (summary.get("verdicts") or {}):
+        raise ValueError(
+            "summary.json has no verdicts['claims']: it was written before the claims were "
+            "decided in the summary step; rerun that step (snakemake reruns it on the new code)"
+        )
     return {
         "text": _constants_text(summary),
         "setup": setup_text(setup),
         "series": _model_numbers(summary),
         "dissipation": _dissipation_numbers(summary),
-        "claims": claims(summary, delays, ssw),
+        "claims": summary["verdicts"]["claims"],
         "fits": fit_rows(summary),
         "ssw_slopes": ssw_slope_rows(summary),
         "findings": findings(summary),
@@ -412,7 +418,7 @@ def figure_entries(
     """The run's figures for the article: ``name`` (file stem), ``path`` (from the typst
     root, with a leading ``/``), ``section``, ``caption`` and ``paragraph`` (from
     ``texts``, the ``figure_text`` of :func:`article_numbers`; a figure not in it gets
-    the generic text of :func:`chain.report.article_figures.figure_text`)."""
+    the generic text of :func:`chain.report.text.article_figures.figure_text`)."""
     texts = texts or {}
     out = []
     for path in paths:

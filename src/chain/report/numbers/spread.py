@@ -1,5 +1,6 @@
 """Summary entries of the ablation of the virtual experiment and of the spread of C
-(``summary.json`` keys ``ablation`` and ``c_spread``, and their ``summary.md`` rows).
+(``summary.json`` keys ``ablation`` and ``c_spread``; their ``summary.md`` rows are in
+:mod:`chain.report.text.markdown_studies`).
 
 The numbers come from ``tables/ablation_exponent.csv`` (chain.studies.ablation_table) and
 ``tables/c_sensitivity.csv`` (chain.studies.c_sensitivity); nothing is computed here
@@ -9,7 +10,6 @@ but the selection of rows and the wording.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 
 import pandas as pd
 
@@ -107,31 +107,3 @@ def c_spread_summary(table: pd.DataFrame) -> dict:
         "n_headline_rows": len(sim),
         "rows": _records(table),
     }
-
-
-def spread_markdown_rows(summary: Mapping) -> list[tuple[str, str, str, str]]:
-    """``summary.md`` rows (quantity | paper | this run | note) for both keys, if present."""
-    rows = []
-    ablation = summary.get("ablation")
-    if ablation:
-        rows.append(
-            (
-                f"why the {VIRTUAL_LABEL}'s exponent differs (ablation)",
-                "—",
-                ablation["verdict"],
-                "tables/ablation_exponent.csv; every variant: tables/ablation_exponent_all.csv",
-            )
-        )
-    spread = summary.get("c_spread")
-    if spread:
-        rows.append(
-            (
-                "C of the simulation: headline choice and spread over choices (µs N^1/6)",
-                "—",
-                f"{spread['headline_C_us_N16']:.2f}; {spread['min_us_N16']:.2f} "
-                f"({spread['min_choice']}) .. {spread['max_us_N16']:.2f} ({spread['max_choice']})",
-                f"headline: {spread['headline_choice']}; one choice changed at a time "
-                "(estimator, eta, sensor pair, amplitude half): tables/c_sensitivity.csv",
-            )
-        )
-    return rows

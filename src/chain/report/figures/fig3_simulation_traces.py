@@ -1,6 +1,6 @@
 """Fig. 3: simulated forces felt by the sensor beads (the sensors are not modelled).
 
-The panels are drawn by :mod:`chain.report.trace_panels`, shared with Fig. 2.
+The panels are drawn by :mod:`chain.report.figures.trace_panels`, shared with Fig. 2.
 """
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from __future__ import annotations
 import pandas as pd
 from matplotlib.figure import Figure
 
-from chain.report.trace_panels import trace_figure
+from chain.report.figures.trace_panels import trace_figure
 
 
 def fig3_simulation_traces(

@@ -235,16 +235,6 @@ def pooled_fits(fits, estimator: str):
     return [fit for fit in chosen.itertuples() if np.isfinite(fit.C_us_N16)]
 
 
-def chain_slopes(fits) -> dict:
-    """``{(source, model, N): (slope, stderr)}`` of the per-chain SSW fits drawn."""
-    slopes = {}
-    if fits is not None and len(fits):
-        for fit in main_method(fits).itertuples():
-            if str(fit.N) != "pooled":
-                slopes[(fit.source, fit.model, int(fit.N))] = (fit.slope, fit.slope_stderr)
-    return slopes
-
-
 def representative_shots(table, pulses, selection, *, source, n, estimator, force, index):
     """The collision and reference shot of one chain drawn in Fig. 2/3 (rows, or None).
 
