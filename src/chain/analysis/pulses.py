@@ -134,11 +134,43 @@ def cos6_model(time_s, peak_force_N: float, arrival_time_s: float, tau_s: float)
     return peak_force_N * np.cos((np.asarray(time_s) - arrival_time_s) / tau_s) ** 6
 
 
-def _cos6_jacobian(time_s, peak_force_N, arrival_time_s, tau_s):
-    phase = (time_s - arrival_time_s) / tau_s
-    c, s = np.cos(phase), np.sin(phase)
-    slope = 6.0 * peak_force_N * c**5 * s  # = -dF/dphase
-    return np.column_stack((c**6, slope / tau_s, slope * phase / tau_s))
+class _Cos6Evaluations:
+    """:func:`cos6_model` and its Jacobian on one fit window, for ``curve_fit``.
+
+    MINPACK asks for the Jacobian at the point where it last evaluated the model (the
+    step it accepted), so the phase, its cosine and cos^6 of that evaluation are kept
+    and reused: the same operations on the same numbers, hence the same bits, in fewer
+    passes over the window. The Jacobian is returned row-wise (``col_deriv=True``),
+    which MINPACK reads as the same matrix without a transpose.
+    """
+
+    def __init__(self):
+        self._point = None
+        self._parts = None
+
+    def _phase_parts(self, time, peak_force_N, arrival_time_s, tau_s):
+        point = (peak_force_N, arrival_time_s, tau_s)
+        if point != self._point:
+            phase = (time - arrival_time_s) / tau_s
+            cosine = np.cos(phase)
+            self._parts = (phase, cosine, cosine**6)
+            self._point = point
+        return self._parts
+
+    def model(self, time_s, peak_force_N, arrival_time_s, tau_s):
+        """F_m cos^6((t - T)/tau), N (as :func:`cos6_model`; ``time_s`` an array, s)."""
+        return peak_force_N * self._phase_parts(time_s, peak_force_N, arrival_time_s, tau_s)[2]
+
+    def jacobian(self, time_s, peak_force_N, arrival_time_s, tau_s):
+        """d model / d(F_m, T, tau), one row per parameter (1, N/s, N/s)."""
+        phase, cosine, cos6 = self._phase_parts(time_s, peak_force_N, arrival_time_s, tau_s)
+        slope = 6.0 * peak_force_N * cosine**5 * np.sin(phase)  # = -dF/dphase
+        rows = np.empty((3, len(phase)))
+        rows[0] = cos6
+        np.divide(slope, tau_s, out=rows[1])
+        np.multiply(slope, phase, out=rows[2])
+        rows[2] /= tau_s
+        return rows
 
 
 def estimate_baseline(time_s, force_N) -> tuple[float, float]:
@@ -310,11 +342,52 @@ def fit_pulse(
     """
     if estimator not in ESTIMATORS:
         raise ParameterError(f"estimator must be one of {ESTIMATORS}, got {estimator!r}")
+    fits = measure_pulse(time_s, force_N, (estimator,), baseline_N=baseline_N, noise_N=noise_N)
+    return fits[estimator]
+
+
+def measure_pulse(
+    time_s,
+    force_N,
+    estimators=ESTIMATORS,
+    *,
+    baseline_N: float | None = None,
+    noise_N: float | None = None,
+) -> dict[str, PulseFit]:
+    """The largest pulse of a signal measured with each of several estimators.
+
+    What :func:`fit_pulse` gives for each estimator, with the checks, the baseline and
+    the width at half maximum (the initial tau) found once for all of them.
+
+    Parameters
+    ----------
+    time_s : array
+        Times, s, increasing and evenly sampled.
+    force_N : array
+        Signal, N.
+    estimators : sequence of str
+        Names from :data:`ESTIMATORS`.
+    baseline_N, noise_N : float, optional
+        Baseline offset and noise standard deviation, N; estimated from the signal by
+        :func:`estimate_baseline` when not given.
+
+    Returns
+    -------
+    dict of str to PulseFit
+        One fit per estimator; ``ok=False`` with a reason where it cannot be measured.
+    """
+    unknown = [e for e in estimators if e not in ESTIMATORS]
+    if unknown:
+        raise ParameterError(f"estimators must be among {ESTIMATORS}, got {unknown}")
     time, force = _as_signal(time_s, force_N)
+
+    def failed(reason: str) -> dict[str, PulseFit]:
+        return dict.fromkeys(estimators, PulseFit.failed(reason))
+
     if len(time) < MIN_FIT_SAMPLES:
-        return PulseFit.failed(f"fewer than {MIN_FIT_SAMPLES} samples")
+        return failed(f"fewer than {MIN_FIT_SAMPLES} samples")
     if not (np.all(np.isfinite(time)) and np.all(np.isfinite(force))):
-        return PulseFit.failed("non-finite samples")
+        return failed("non-finite samples")
     if baseline_N is None or noise_N is None:
         estimated = estimate_baseline(time, force)
         baseline_N = estimated[0] if baseline_N is None else baseline_N
@@ -322,15 +395,18 @@ def fit_pulse(
     signal = force - baseline_N
     peak = int(np.argmax(signal))
     if not signal[peak] > 0:
-        return PulseFit.failed("no positive pulse")
+        return failed("no positive pulse")
     half_width = _half_width_samples(signal, peak)
     if not half_width > 0:
-        return PulseFit.failed("pulse width not measurable")
+        return failed("pulse width not measurable")
     dt = float(np.median(np.diff(time)))
     tau0 = half_width * dt / COS6_FWHM_PER_TAU
-    if estimator == "peak":
-        return _peak_estimate(time, signal, peak, tau0, noise_N)
-    return _iterated_fit(time, signal, peak, tau0, rising_only=estimator == "fit_rise")
+    return {
+        estimator: _peak_estimate(time, signal, peak, tau0, noise_N, dt)
+        if estimator == "peak"
+        else _iterated_fit(time, signal, peak, tau0, rising_only=estimator == "fit_rise")
+        for estimator in estimators
+    }
 
 
 def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
@@ -380,12 +456,14 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error", OptimizeWarning)
+                evaluations = _Cos6Evaluations()
                 params, covariance = curve_fit(
-                    cos6_model,
+                    evaluations.model,
                     time[start:stop],
                     signal[start:stop],
                     p0=params,
-                    jac=_cos6_jacobian,
+                    jac=evaluations.jacobian,
+                    col_deriv=True,
                     maxfev=2000,
                 )
         except (RuntimeError, OptimizeWarning, ValueError) as error:
@@ -415,9 +493,12 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
     return PulseFit.failed(f"fit window not stable after {MAX_WINDOW_ITERATIONS} iterations")
 
 
-def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
-    """Vertex of the least-squares parabola through the samples around the maximum."""
-    dt = float(np.median(np.diff(time)))
+def _peak_estimate(time, signal, peak, tau0, noise, dt) -> PulseFit:
+    """Vertex of the least-squares parabola through the samples around the maximum.
+
+    ``peak`` is the largest sample, ``tau0`` tau from its width at half maximum (s), also
+    the value returned; ``dt`` the sampling interval, s.
+    """
     # A parabola over tau/2 (quadratic Savitzky-Golay coefficients) averages the noise
     # over the top of the pulse, where cos^6 is still a parabola to 0.2 %; when the
     # pulse spans few samples this is the 3-point parabolic interpolation.
@@ -444,7 +525,7 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
     if abs(offset) > half * dt:
         return PulseFit.failed("peak vertex outside the fitted samples")
     peak_value = value - 0.5 * slope**2 / curvature
-    tau = _half_width_samples(signal, int(np.argmax(signal))) * dt / COS6_FWHM_PER_TAU
+    tau = tau0
     # Noise propagation: the value carries the filter's noise gain; the vertex moves by
     # the slope's noise over the curvature; each half-maximum crossing moves by
     # noise / |slope|, and |dF/dt| of cos^6 at half maximum is 1.527 F_m / tau.
