@@ -186,17 +186,17 @@ def test_fit_model_and_jacobian_are_the_plain_formulas_bit_for_bit():
     """The fit's model and Jacobian, sharing the phase between calls, give the bits of
     the formulas written out (cos6_model; d/dF, d/dT, d/dtau of it), in any call order,
     and the Jacobian is the model's derivative."""
-    from chain.analysis.pulses import _Cos6Evaluations
+    from chain.analysis.cos6 import Cos6Evaluations
 
     time = TIME_S[300:500]
     point = (PEAK_N, ARRIVAL_S + 0.3e-6, TAU_S)
     phase = (time - point[1]) / point[2]
     slope = 6.0 * point[0] * np.cos(phase) ** 5 * np.sin(phase)
     plain = np.column_stack((np.cos(phase) ** 6, slope / point[2], slope * phase / point[2]))
-    shared = _Cos6Evaluations()
+    shared = Cos6Evaluations()
     np.testing.assert_array_equal(shared.model(time, *point), cos6_model(time, *point))
     np.testing.assert_array_equal(shared.jacobian(time, *point), plain.T)
-    np.testing.assert_array_equal(_Cos6Evaluations().jacobian(time, *point), plain.T)
+    np.testing.assert_array_equal(Cos6Evaluations().jacobian(time, *point), plain.T)
     other = (1.1 * PEAK_N, ARRIVAL_S, 0.9 * TAU_S)
     np.testing.assert_array_equal(shared.model(time, *other), cos6_model(time, *other))
     for i, step in enumerate((1e-3, 1e-12, 1e-11)):
@@ -274,7 +274,7 @@ def test_smoothed_interior_is_the_savgol_filter_bit_for_bit():
     scipy's filter on the whole signal, away from the filter's polynomial edges."""
     from scipy.signal import savgol_filter
 
-    from chain.analysis.pulses import _smoothed_interior
+    from chain.analysis.smoothing import smoothed_interior
 
     rng = np.random.default_rng(3)
     signal = cos6_pulse(TIME_S, PEAK_N, ARRIVAL_S, TAU_S) + rng.normal(0, 2.0, TIME_S.size)
@@ -282,4 +282,4 @@ def test_smoothed_interior_is_the_savgol_filter_bit_for_bit():
         half = length // 2
         full = savgol_filter(signal, length, 2)
         for lo, hi in ((half, half + 7), (380, 420), (TIME_S.size - half - 9, TIME_S.size - half)):
-            np.testing.assert_array_equal(_smoothed_interior(signal, length, lo, hi), full[lo:hi])
+            np.testing.assert_array_equal(smoothed_interior(signal, length, lo, hi), full[lo:hi])

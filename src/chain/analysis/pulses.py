@@ -31,10 +31,14 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
+from chain.analysis.cos6 import (  # noqa: F401 (cos6_model: a public name here too)
+    Cos6Evaluations,
+    cos6_model,
+)
+from chain.analysis.smoothing import savgol_dot_coefficients, smoothed_interior
 from chain.errors import ParameterError
 
 #: Names of the amplitude/arrival-time estimators, the paper's first.
@@ -119,58 +123,6 @@ class PulseSegment:
     @property
     def slice(self) -> slice:
         return slice(self.start, self.stop)
-
-
-def cos6_model(time_s, peak_force_N: float, arrival_time_s: float, tau_s: float):
-    """F_m cos^6((t - T)/tau) without the cut-off outside the hump (fits use |t-T| < tau), N.
-
-    Parameters
-    ----------
-    time_s : array
-        Times, s.
-    peak_force_N, arrival_time_s, tau_s : float
-        F_m (N), T (s), tau (s).
-    """
-    return peak_force_N * np.cos((np.asarray(time_s) - arrival_time_s) / tau_s) ** 6
-
-
-class _Cos6Evaluations:
-    """:func:`cos6_model` and its Jacobian on one fit window, for ``curve_fit``.
-
-    MINPACK asks for the Jacobian at the point where it last evaluated the model (the
-    step it accepted), so the phase, its cosine and cos^6 of that evaluation are kept
-    and reused: the same operations on the same numbers, hence the same bits, in fewer
-    passes over the window. The Jacobian is returned row-wise (``col_deriv=True``),
-    which MINPACK reads as the same matrix without a transpose.
-    """
-
-    def __init__(self):
-        self._point = None
-        self._parts = None
-
-    def _phase_parts(self, time, peak_force_N, arrival_time_s, tau_s):
-        point = (peak_force_N, arrival_time_s, tau_s)
-        if point != self._point:
-            phase = (time - arrival_time_s) / tau_s
-            cosine = np.cos(phase)
-            self._parts = (phase, cosine, cosine**6)
-            self._point = point
-        return self._parts
-
-    def model(self, time_s, peak_force_N, arrival_time_s, tau_s):
-        """F_m cos^6((t - T)/tau), N (as :func:`cos6_model`; ``time_s`` an array, s)."""
-        return peak_force_N * self._phase_parts(time_s, peak_force_N, arrival_time_s, tau_s)[2]
-
-    def jacobian(self, time_s, peak_force_N, arrival_time_s, tau_s):
-        """d model / d(F_m, T, tau), one row per parameter (1, N/s, N/s)."""
-        phase, cosine, cos6 = self._phase_parts(time_s, peak_force_N, arrival_time_s, tau_s)
-        slope = 6.0 * peak_force_N * cosine**5 * np.sin(phase)  # = -dF/dphase
-        rows = np.empty((3, len(phase)))
-        rows[0] = cos6
-        np.divide(slope, tau_s, out=rows[1])
-        np.multiply(slope, phase, out=rows[2])
-        rows[2] /= tau_s
-        return rows
 
 
 def estimate_baseline(time_s, force_N) -> tuple[float, float]:
@@ -456,7 +408,7 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error", OptimizeWarning)
-                evaluations = _Cos6Evaluations()
+                evaluations = Cos6Evaluations()
                 params, covariance = curve_fit(
                     evaluations.model,
                     time[start:stop],
@@ -508,10 +460,10 @@ def _peak_estimate(time, signal, peak, tau0, noise, dt) -> PulseFit:
     if hi <= lo:
         return PulseFit.failed("peak at the segment edge")
     if len(signal) > length:
-        centre = lo + int(np.argmax(_smoothed_interior(signal, length, lo, hi)))
+        centre = lo + int(np.argmax(smoothed_interior(signal, length, lo, hi)))
     else:
         centre = lo + int(np.argmax(signal[lo:hi]))
-    coefficients = _savgol_dot_coefficients(length, dt)
+    coefficients = savgol_dot_coefficients(length, dt)
     for _ in range(2):  # re-centre once on the sample nearest the vertex
         around = signal[centre - half : centre + half + 1]
         value, slope, curvature = (float(np.dot(c, around)) for c in coefficients)
@@ -525,58 +477,18 @@ def _peak_estimate(time, signal, peak, tau0, noise, dt) -> PulseFit:
     if abs(offset) > half * dt:
         return PulseFit.failed("peak vertex outside the fitted samples")
     peak_value = value - 0.5 * slope**2 / curvature
-    tau = tau0
     # Noise propagation: the value carries the filter's noise gain; the vertex moves by
     # the slope's noise over the curvature; each half-maximum crossing moves by
     # noise / |slope|, and |dF/dt| of cos^6 at half maximum is 1.527 F_m / tau.
     value_error = noise * math.sqrt(float(np.sum(coefficients[0] ** 2)))
     time_error = noise * math.sqrt(float(np.sum(coefficients[1] ** 2))) / abs(curvature)
-    tau_error = math.sqrt(2.0) * noise / (1.527 * peak_value / tau) / COS6_FWHM_PER_TAU
+    tau_error = math.sqrt(2.0) * noise / (1.527 * peak_value / tau0) / COS6_FWHM_PER_TAU
     return PulseFit(
         float(peak_value),
         float(time[centre] + offset),
-        float(tau),
+        float(tau0),
         float(value_error),
         float(time_error),
         float(tau_error),
         n_samples=length,
     )
-
-
-@lru_cache(maxsize=64)
-def _savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
-    """Quadratic Savitzky-Golay coefficients of the value, slope (1/s) and curvature
-    (1/s^2) at the centre of ``length`` samples ``dt`` s apart (for ``np.dot``).
-
-    Cached: every pulse of a sweep sampled alike asks for the same few (read-only).
-    """
-    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
-
-    coefficients = tuple(savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
-    for c in coefficients:
-        c.flags.writeable = False
-    return coefficients
-
-
-@lru_cache(maxsize=64)
-def _savgol_smoothing(length: int) -> np.ndarray:
-    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only, cached)."""
-    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
-
-    coefficients = savgol_coeffs(length, 2)
-    coefficients.flags.writeable = False
-    return coefficients
-
-
-def _smoothed_interior(signal: np.ndarray, length: int, lo: int, hi: int) -> np.ndarray:
-    """``savgol_filter(signal, length, 2)[lo:hi]`` for ``length // 2 <= lo < hi <=
-    len(signal) - length // 2``, where every window lies inside the signal.
-
-    The same convolution as the filter's on just the samples these windows cover (the
-    filter's polynomial fits at the edges are never read), so the same values, N.
-    """
-    from scipy.ndimage import convolve1d  # imported here: see find_pulses
-
-    half = length // 2
-    part = signal[lo - half : hi + half]
-    return convolve1d(part, _savgol_smoothing(length), mode="constant")[half : half + hi - lo]
