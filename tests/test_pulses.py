@@ -12,9 +12,11 @@ from chain.analysis.pulse_rows import PULSE_COLUMNS, pulse_table
 from chain.analysis.pulses import (
     COS6_FWHM_PER_TAU,
     ESTIMATORS,
+    cos6_model,
     estimate_baseline,
     find_pulses,
     fit_pulse,
+    measure_pulse,
 )
 from chain.physics.theory import cos6_pulse
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
@@ -162,6 +164,49 @@ def test_failures_are_flagged_not_raised():
         fit_pulse(TIME_S, np.zeros_like(TIME_S), "no_such_estimator")
 
 
+def test_measure_pulse_is_fit_pulse_per_estimator():
+    """One pass over a pulse for every estimator gives each estimator's fit_pulse, to the
+    bit (repr of a float round-trips), failures included."""
+    signals = [
+        (TIME_S, noisy_pulse(seed=5)),
+        (TIME_S, cos6_pulse(TIME_S, PEAK_N, ARRIVAL_S + 0.3e-6, TAU_S)),
+        (TIME_S, np.zeros_like(TIME_S)),
+        (TIME_S[:4], np.ones(4)),
+    ]
+    for time, force in signals:
+        fits = measure_pulse(time, force, ESTIMATORS)
+        assert list(fits) == list(ESTIMATORS)
+        for estimator in ESTIMATORS:
+            assert repr(fits[estimator]) == repr(fit_pulse(time, force, estimator))
+    with pytest.raises(ValueError, match="no_such_estimator"):
+        measure_pulse(TIME_S, noisy_pulse(seed=5), ("fit_full", "no_such_estimator"))
+
+
+def test_fit_model_and_jacobian_are_the_plain_formulas_bit_for_bit():
+    """The fit's model and Jacobian, sharing the phase between calls, give the bits of
+    the formulas written out (cos6_model; d/dF, d/dT, d/dtau of it), in any call order,
+    and the Jacobian is the model's derivative."""
+    from chain.analysis.cos6 import Cos6Evaluations
+
+    time = TIME_S[300:500]
+    point = (PEAK_N, ARRIVAL_S + 0.3e-6, TAU_S)
+    phase = (time - point[1]) / point[2]
+    slope = 6.0 * point[0] * np.cos(phase) ** 5 * np.sin(phase)
+    plain = np.column_stack((np.cos(phase) ** 6, slope / point[2], slope * phase / point[2]))
+    shared = Cos6Evaluations()
+    np.testing.assert_array_equal(shared.model(time, *point), cos6_model(time, *point))
+    np.testing.assert_array_equal(shared.jacobian(time, *point), plain.T)
+    np.testing.assert_array_equal(Cos6Evaluations().jacobian(time, *point), plain.T)
+    other = (1.1 * PEAK_N, ARRIVAL_S, 0.9 * TAU_S)
+    np.testing.assert_array_equal(shared.model(time, *other), cos6_model(time, *other))
+    for i, step in enumerate((1e-3, 1e-12, 1e-11)):
+        moved = np.array(point)
+        moved[i] += step
+        numeric = (cos6_model(time, *moved) - cos6_model(time, *point)) / step
+        scale = np.max(np.abs(plain[:, i]))
+        np.testing.assert_allclose(numeric, plain[:, i], atol=1e-4 * scale)
+
+
 def shot_rows(shot, kind, amplitude, s1, s2):
     """One shot of a synthetic two-sensor trace table (beads 9 and 17 of N = 25)."""
     return pd.DataFrame(
@@ -229,7 +274,7 @@ def test_smoothed_interior_is_the_savgol_filter_bit_for_bit():
     scipy's filter on the whole signal, away from the filter's polynomial edges."""
     from scipy.signal import savgol_filter
 
-    from chain.analysis.pulses import _smoothed_interior
+    from chain.analysis.smoothing import smoothed_interior
 
     rng = np.random.default_rng(3)
     signal = cos6_pulse(TIME_S, PEAK_N, ARRIVAL_S, TAU_S) + rng.normal(0, 2.0, TIME_S.size)
@@ -237,4 +282,4 @@ def test_smoothed_interior_is_the_savgol_filter_bit_for_bit():
         half = length // 2
         full = savgol_filter(signal, length, 2)
         for lo, hi in ((half, half + 7), (380, 420), (TIME_S.size - half - 9, TIME_S.size - half)):
-            np.testing.assert_array_equal(_smoothed_interior(signal, length, lo, hi), full[lo:hi])
+            np.testing.assert_array_equal(smoothed_interior(signal, length, lo, hi), full[lo:hi])

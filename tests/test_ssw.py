@@ -249,3 +249,29 @@ def test_selection_and_missing_pulses():
     table = ssw_of(validate_traces(silent))
     assert not table["ok"].any()
     assert table["reason"].str.contains("reference").all()
+
+
+def test_smoothing_only_the_samples_read_is_the_filter_bit_for_bit():
+    """measure_ssw smooths only the samples from the rising edge to the window's end:
+    there the values of scipy's filter on the whole record, bit for bit; a range whose
+    windows reach the record's ends gets the whole filter, polynomial edges included."""
+    from scipy.signal import savgol_filter
+
+    from chain.analysis.smoothing import smoother
+
+    rng = np.random.default_rng(5)
+    signal = cos6_pulse(TIME_S, REFERENCE_N, 500e-6, REFERENCE_TAU_S)
+    signal = signal + rng.normal(0.0, NOISE_N, TIME_S.size)
+    length = round(0.5 * REFERENCE_TAU_S / 1e-6) | 1
+    full = savgol_filter(signal, length, 2)
+    for lo, hi in ((420, 980), (length // 2, TIME_S.size - length // 2)):
+        smooth, gain = smoother(TIME_S, REFERENCE_TAU_S, lo, hi)
+        part = smooth(signal)
+        np.testing.assert_array_equal(part[lo:hi], full[lo:hi])
+        assert np.isnan(part[:lo]).all() and np.isnan(part[hi:]).all()
+        # White-noise gain^2 of a least-squares filter is its central weight, for the
+        # quadratic one 3 (3 L^2 - 7) / (4 L (L^2 - 4)).
+        centre = 3 * (3 * length**2 - 7) / (4 * length * (length**2 - 4))
+        assert gain == pytest.approx(np.sqrt(centre), rel=1e-12)
+    for lo, hi in ((3, 980), (420, TIME_S.size)):
+        np.testing.assert_array_equal(smoother(TIME_S, REFERENCE_TAU_S, lo, hi)[0](signal), full)

@@ -2,7 +2,7 @@
 
 Each sensor signal of each shot is split into its main pulses
 (:func:`chain.analysis.pulses.find_pulses`) and every pulse is measured with each asked
-estimator (:func:`chain.analysis.pulses.fit_pulse`). Sensor S1 is the first sensor
+estimator (:func:`chain.analysis.pulses.measure_pulse`). Sensor S1 is the first sensor
 column of the trace table, S2 the last. Roles (see ``docs/interfaces.md``): in a
 collision shot the 1st pulse at S1 is the incident LSTW and the 2nd the crossed RSTW; at
 S2 the 1st is the incident RSTW and the 2nd the crossed LSTW; a reference shot has one
@@ -12,8 +12,6 @@ SI units inside; table columns carry their unit.
 """
 
 from __future__ import annotations
-
-from dataclasses import asdict
 
 import numpy as np
 import pandas as pd
@@ -25,7 +23,7 @@ from chain.analysis.pulses import (
     PulseFit,
     estimate_baseline,
     find_pulses,
-    fit_pulse,
+    measure_pulse,
 )
 from chain.errors import ParameterError
 from chain.traces import iter_shots, sensor_beads
@@ -137,15 +135,16 @@ def _sensor_rows(
     )
     rows = []
     for i, (role, wave) in enumerate(roles):
+        if i < len(segments):
+            part = segments[i].slice
+            fits = measure_pulse(
+                time[part], force[part], estimators, baseline_N=baseline, noise_N=noise
+            )
+        else:
+            found = f" ({len(segments)} of {len(roles)} found)" if segments else ""
+            fits = dict.fromkeys(estimators, PulseFit.failed("no pulse detected" + found))
         for estimator in estimators:
-            if i < len(segments):
-                part = segments[i].slice
-                fit = fit_pulse(
-                    time[part], force[part], estimator, baseline_N=baseline, noise_N=noise
-                )
-            else:
-                found = f" ({len(segments)} of {len(roles)} found)" if segments else ""
-                fit = PulseFit.failed("no pulse detected" + found)
+            fit = fits[estimator]
             rows.append(
                 {
                     **columns,
@@ -171,15 +170,14 @@ def _roles(kind: str, sensor: str) -> list[tuple[str, str]]:
 
 def _fit_columns(fit: PulseFit) -> dict:
     """A :class:`~chain.analysis.pulses.PulseFit` as ``pulses.csv`` columns."""
-    values = asdict(fit)
     return {
-        "F_m_N": values["peak_force"],
-        "T_s": values["arrival_time"],
-        "tau_s": values["tau"],
-        "F_m_stderr_N": values["peak_force_stderr"],
-        "T_stderr_s": values["arrival_time_stderr"],
-        "tau_stderr_s": values["tau_stderr"],
-        "ok": values["ok"],
-        "reason": values["reason"],
-        "n_samples": values["n_samples"],
+        "F_m_N": fit.peak_force,
+        "T_s": fit.arrival_time,
+        "tau_s": fit.tau,
+        "F_m_stderr_N": fit.peak_force_stderr,
+        "T_stderr_s": fit.arrival_time_stderr,
+        "tau_stderr_s": fit.tau_stderr,
+        "ok": fit.ok,
+        "reason": fit.reason,
+        "n_samples": fit.n_samples,
     }

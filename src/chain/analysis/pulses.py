@@ -31,10 +31,14 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
+from chain.analysis.cos6 import (  # noqa: F401 (cos6_model: a public name here too)
+    Cos6Evaluations,
+    cos6_model,
+)
+from chain.analysis.smoothing import savgol_dot_coefficients, smoothed_interior
 from chain.errors import ParameterError
 
 #: Names of the amplitude/arrival-time estimators, the paper's first.
@@ -119,26 +123,6 @@ class PulseSegment:
     @property
     def slice(self) -> slice:
         return slice(self.start, self.stop)
-
-
-def cos6_model(time_s, peak_force_N: float, arrival_time_s: float, tau_s: float):
-    """F_m cos^6((t - T)/tau) without the cut-off outside the hump (fits use |t-T| < tau), N.
-
-    Parameters
-    ----------
-    time_s : array
-        Times, s.
-    peak_force_N, arrival_time_s, tau_s : float
-        F_m (N), T (s), tau (s).
-    """
-    return peak_force_N * np.cos((np.asarray(time_s) - arrival_time_s) / tau_s) ** 6
-
-
-def _cos6_jacobian(time_s, peak_force_N, arrival_time_s, tau_s):
-    phase = (time_s - arrival_time_s) / tau_s
-    c, s = np.cos(phase), np.sin(phase)
-    slope = 6.0 * peak_force_N * c**5 * s  # = -dF/dphase
-    return np.column_stack((c**6, slope / tau_s, slope * phase / tau_s))
 
 
 def estimate_baseline(time_s, force_N) -> tuple[float, float]:
@@ -310,11 +294,52 @@ def fit_pulse(
     """
     if estimator not in ESTIMATORS:
         raise ParameterError(f"estimator must be one of {ESTIMATORS}, got {estimator!r}")
+    fits = measure_pulse(time_s, force_N, (estimator,), baseline_N=baseline_N, noise_N=noise_N)
+    return fits[estimator]
+
+
+def measure_pulse(
+    time_s,
+    force_N,
+    estimators=ESTIMATORS,
+    *,
+    baseline_N: float | None = None,
+    noise_N: float | None = None,
+) -> dict[str, PulseFit]:
+    """The largest pulse of a signal measured with each of several estimators.
+
+    What :func:`fit_pulse` gives for each estimator, with the checks, the baseline and
+    the width at half maximum (the initial tau) found once for all of them.
+
+    Parameters
+    ----------
+    time_s : array
+        Times, s, increasing and evenly sampled.
+    force_N : array
+        Signal, N.
+    estimators : sequence of str
+        Names from :data:`ESTIMATORS`.
+    baseline_N, noise_N : float, optional
+        Baseline offset and noise standard deviation, N; estimated from the signal by
+        :func:`estimate_baseline` when not given.
+
+    Returns
+    -------
+    dict of str to PulseFit
+        One fit per estimator; ``ok=False`` with a reason where it cannot be measured.
+    """
+    unknown = [e for e in estimators if e not in ESTIMATORS]
+    if unknown:
+        raise ParameterError(f"estimators must be among {ESTIMATORS}, got {unknown}")
     time, force = _as_signal(time_s, force_N)
+
+    def failed(reason: str) -> dict[str, PulseFit]:
+        return dict.fromkeys(estimators, PulseFit.failed(reason))
+
     if len(time) < MIN_FIT_SAMPLES:
-        return PulseFit.failed(f"fewer than {MIN_FIT_SAMPLES} samples")
+        return failed(f"fewer than {MIN_FIT_SAMPLES} samples")
     if not (np.all(np.isfinite(time)) and np.all(np.isfinite(force))):
-        return PulseFit.failed("non-finite samples")
+        return failed("non-finite samples")
     if baseline_N is None or noise_N is None:
         estimated = estimate_baseline(time, force)
         baseline_N = estimated[0] if baseline_N is None else baseline_N
@@ -322,15 +347,18 @@ def fit_pulse(
     signal = force - baseline_N
     peak = int(np.argmax(signal))
     if not signal[peak] > 0:
-        return PulseFit.failed("no positive pulse")
+        return failed("no positive pulse")
     half_width = _half_width_samples(signal, peak)
     if not half_width > 0:
-        return PulseFit.failed("pulse width not measurable")
+        return failed("pulse width not measurable")
     dt = float(np.median(np.diff(time)))
     tau0 = half_width * dt / COS6_FWHM_PER_TAU
-    if estimator == "peak":
-        return _peak_estimate(time, signal, peak, tau0, noise_N)
-    return _iterated_fit(time, signal, peak, tau0, rising_only=estimator == "fit_rise")
+    return {
+        estimator: _peak_estimate(time, signal, peak, tau0, noise_N, dt)
+        if estimator == "peak"
+        else _iterated_fit(time, signal, peak, tau0, rising_only=estimator == "fit_rise")
+        for estimator in estimators
+    }
 
 
 def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
@@ -380,12 +408,14 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error", OptimizeWarning)
+                evaluations = Cos6Evaluations()
                 params, covariance = curve_fit(
-                    cos6_model,
+                    evaluations.model,
                     time[start:stop],
                     signal[start:stop],
                     p0=params,
-                    jac=_cos6_jacobian,
+                    jac=evaluations.jacobian,
+                    col_deriv=True,
                     maxfev=2000,
                 )
         except (RuntimeError, OptimizeWarning, ValueError) as error:
@@ -415,9 +445,12 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
     return PulseFit.failed(f"fit window not stable after {MAX_WINDOW_ITERATIONS} iterations")
 
 
-def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
-    """Vertex of the least-squares parabola through the samples around the maximum."""
-    dt = float(np.median(np.diff(time)))
+def _peak_estimate(time, signal, peak, tau0, noise, dt) -> PulseFit:
+    """Vertex of the least-squares parabola through the samples around the maximum.
+
+    ``peak`` is the largest sample, ``tau0`` tau from its width at half maximum (s), also
+    the value returned; ``dt`` the sampling interval, s.
+    """
     # A parabola over tau/2 (quadratic Savitzky-Golay coefficients) averages the noise
     # over the top of the pulse, where cos^6 is still a parabola to 0.2 %; when the
     # pulse spans few samples this is the 3-point parabolic interpolation.
@@ -427,10 +460,10 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
     if hi <= lo:
         return PulseFit.failed("peak at the segment edge")
     if len(signal) > length:
-        centre = lo + int(np.argmax(_smoothed_interior(signal, length, lo, hi)))
+        centre = lo + int(np.argmax(smoothed_interior(signal, length, lo, hi)))
     else:
         centre = lo + int(np.argmax(signal[lo:hi]))
-    coefficients = _savgol_dot_coefficients(length, dt)
+    coefficients = savgol_dot_coefficients(length, dt)
     for _ in range(2):  # re-centre once on the sample nearest the vertex
         around = signal[centre - half : centre + half + 1]
         value, slope, curvature = (float(np.dot(c, around)) for c in coefficients)
@@ -444,58 +477,18 @@ def _peak_estimate(time, signal, peak, tau0, noise) -> PulseFit:
     if abs(offset) > half * dt:
         return PulseFit.failed("peak vertex outside the fitted samples")
     peak_value = value - 0.5 * slope**2 / curvature
-    tau = _half_width_samples(signal, int(np.argmax(signal))) * dt / COS6_FWHM_PER_TAU
     # Noise propagation: the value carries the filter's noise gain; the vertex moves by
     # the slope's noise over the curvature; each half-maximum crossing moves by
     # noise / |slope|, and |dF/dt| of cos^6 at half maximum is 1.527 F_m / tau.
     value_error = noise * math.sqrt(float(np.sum(coefficients[0] ** 2)))
     time_error = noise * math.sqrt(float(np.sum(coefficients[1] ** 2))) / abs(curvature)
-    tau_error = math.sqrt(2.0) * noise / (1.527 * peak_value / tau) / COS6_FWHM_PER_TAU
+    tau_error = math.sqrt(2.0) * noise / (1.527 * peak_value / tau0) / COS6_FWHM_PER_TAU
     return PulseFit(
         float(peak_value),
         float(time[centre] + offset),
-        float(tau),
+        float(tau0),
         float(value_error),
         float(time_error),
         float(tau_error),
         n_samples=length,
     )
-
-
-@lru_cache(maxsize=64)
-def _savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
-    """Quadratic Savitzky-Golay coefficients of the value, slope (1/s) and curvature
-    (1/s^2) at the centre of ``length`` samples ``dt`` s apart (for ``np.dot``).
-
-    Cached: every pulse of a sweep sampled alike asks for the same few (read-only).
-    """
-    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
-
-    coefficients = tuple(savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
-    for c in coefficients:
-        c.flags.writeable = False
-    return coefficients
-
-
-@lru_cache(maxsize=64)
-def _savgol_smoothing(length: int) -> np.ndarray:
-    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only, cached)."""
-    from scipy.signal import savgol_coeffs  # imported here: see find_pulses
-
-    coefficients = savgol_coeffs(length, 2)
-    coefficients.flags.writeable = False
-    return coefficients
-
-
-def _smoothed_interior(signal: np.ndarray, length: int, lo: int, hi: int) -> np.ndarray:
-    """``savgol_filter(signal, length, 2)[lo:hi]`` for ``length // 2 <= lo < hi <=
-    len(signal) - length // 2``, where every window lies inside the signal.
-
-    The same convolution as the filter's on just the samples these windows cover (the
-    filter's polynomial fits at the edges are never read), so the same values, N.
-    """
-    from scipy.ndimage import convolve1d  # imported here: see find_pulses
-
-    half = length // 2
-    part = signal[lo - half : hi + half]
-    return convolve1d(part, _savgol_smoothing(length), mode="constant")[half : half + hi - lo]

@@ -48,6 +48,7 @@ import pandas as pd
 from chain.analysis.pulses import estimate_baseline
 from chain.analysis.rows import is_ok
 from chain.analysis.selection import apply_selection
+from chain.analysis.smoothing import smoother
 from chain.analysis.ssw_fits import (  # noqa: F401 (public names of this module too)
     RESOLUTION_COLUMNS,
     SSW_FIT_COLUMNS,
@@ -115,9 +116,12 @@ _CROSSED = {"S2": ("LSTW", "S1"), "S1": ("RSTW", "S2")}
 
 
 def _template(spline, time, scale, arrival, ref_arrival):
-    # Zero outside the reference record (the spline does not extrapolate).
+    # Zero outside the reference record, where the spline gives NaN. The alignment calls
+    # this thousands of times: one pass, not np.nan_to_num's three (no +-inf here).
     source = ref_arrival + (time - arrival) * scale ** (1.0 / 6.0)
-    return np.nan_to_num(scale * spline(source), nan=0.0)
+    values = scale * spline(source)
+    values[np.isnan(values)] = 0.0
+    return values
 
 
 def measure_ssw(
@@ -192,13 +196,14 @@ def measure_ssw(
         return result
     scale, shift, edge, top = aligned
     template = _template(spline, time, scale, shift, reference_arrival_s)
-    smooth, noise_gain = _smoother(time, crossed_tau_s)
+    last = int(np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)[-1])
+    # Everything below reads samples from the rising edge to the window's end only.
+    smooth, noise_gain = smoother(time, crossed_tau_s, edge.start, last + 1)
     residual = smooth(signal - template)
     # Measured on the smoothed residual, as the SSW is: the noise enters once, below.
     misfit = float(np.max(np.abs(residual[edge])))
     stat = NOISE_SIGMAS * noise_gain * math.hypot(noise_N, scale * reference_noise_N)
     result.update(scale=scale, misfit=misfit, floor=RESOLVE_FACTOR * (misfit + stat), stat=stat)
-    last = int(np.flatnonzero(time <= time[top] + WINDOW_TAUS * crossed_tau_s)[-1])
     prominence = max(MIN_PEAK_FRACTION * crossed_peak_N, MIN_PEAK_SNR * noise_gain * noise_N)
     smoothed = smooth(signal)
     bump = _distinct_bump(smoothed, top, last, prominence)
@@ -242,18 +247,6 @@ def _align_template(time, signal, arrival, tau, scale_guess, spline, ref_arrival
     )
     scale, shift = solution.x
     return float(scale), float(shift), edge, top
-
-
-def _smoother(time, tau):
-    """Quadratic Savitzky-Golay smoothing tau/2 long, and its gain on white noise."""
-    from scipy.signal import savgol_coeffs, savgol_filter  # imported here: see measure_ssw
-
-    dt = float(np.median(np.diff(time)))
-    length = round(0.5 * tau / dt) | 1
-    if not 5 <= length < len(time):
-        return (lambda values: values), 1.0
-    gain = math.sqrt(float(np.sum(savgol_coeffs(length, 2) ** 2)))
-    return (lambda values: savgol_filter(values, length, 2)), gain
 
 
 def _distinct_bump(smoothed, top: int, last: int, prominence: float):
@@ -313,7 +306,8 @@ def ssw_table(
         value <= total error. Rows that cannot be measured: ``ok`` False, ``reason``
         why, ``ssw_N`` NaN.
     """
-    pulses = apply_selection(pulses[pulses["estimator"] == estimator], selection)
+    pulses = _pulses_of_series(traces, pulses[pulses["estimator"] == estimator])
+    pulses = apply_selection(pulses, selection)
     beads = sensor_beads(traces)
     context = {
         "bead_of": {"S1": beads[0], "S2": beads[-1]},
@@ -322,12 +316,17 @@ def ssw_table(
             (row.source, row.model, row.N, row.shot, row.sensor, row.role): row
             for row in pulses.itertuples(index=False)
         },
-        "references": _usable_references(pulses),
+        # The references of each (source, model, N, amplitude), in table order, found
+        # once: their F_m (N) and their rows.
+        "references_of": {
+            key: (group["F_m_N"].to_numpy(float), list(group.itertuples(index=False)))
+            for key, group in _usable_references(pulses).groupby(
+                _REFERENCE_KEY, sort=False, dropna=False
+            )
+        },
+        # (shot, bead) -> baseline and noise, N: a reference serves many collision shots.
+        "baselines": {},
     }
-    # The references of each (source, model, N, amplitude), in table order, found once.
-    context["references_of"] = dict(
-        list(context["references"].groupby(_REFERENCE_KEY, sort=False, dropna=False))
-    )
     keys = ["source", "model", "N", "shot", "amplitude"]
     collisions = pulses[pulses["kind"] == "collision"][keys].drop_duplicates()
     rows = []
@@ -346,6 +345,16 @@ def ssw_table(
 
 #: Columns a reference shares with the collision shots it serves as a template for.
 _REFERENCE_KEY = ["source", "model", "N", "amplitude"]
+#: Columns that name a series; one trace file holds one or a few.
+_SERIES_KEY = ["source", "model", "N"]
+
+
+def _pulses_of_series(traces: pd.DataFrame, pulses: pd.DataFrame) -> pd.DataFrame:
+    """The rows of ``pulses`` of the series in ``traces``: each trace file is measured
+    against the pulses of every file, and the rest would only be looked up in vain."""
+    wanted = set(traces[_SERIES_KEY].drop_duplicates().itertuples(index=False, name=None))
+    keys = pulses[_SERIES_KEY].itertuples(index=False, name=None)
+    return pulses[np.fromiter((key in wanted for key in keys), bool, len(pulses))]
 
 
 def _usable_references(pulses: pd.DataFrame) -> pd.DataFrame:
@@ -370,18 +379,19 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
         "wave": wave,
     }
     same = context["references_of"].get(tuple(getattr(shot, key) for key in _REFERENCE_KEY))
-    same = context["references"].iloc[:0] if same is None else same
     reason = ""
     if crossed is None or not bool(crossed.ok):
         reason = "crossed pulse not measured"
     elif incident is None or not bool(incident.ok):
         reason = "incident pulse not measured"
-    elif same.empty:
+    elif same is None:
         reason = "no usable reference shot of this amplitude"
     if reason:
         return [_row(base, method, math.nan, math.nan, math.nan, reason) for method in SSW_METHODS]
-    # The reference closest in size to the crossed pulse needs the least rescaling.
-    reference = same.loc[(same["F_m_N"] - crossed.F_m_N).abs().idxmin()]
+    # The reference closest in size to the crossed pulse needs the least rescaling (the
+    # first of equals, NaN skipped, as pandas' idxmin).
+    forces_N, references = same
+    reference = references[int(np.nanargmin(np.abs(forces_N - crossed.F_m_N)))]
     result = _measure_at_sensor(shot.shot, sensor, crossed, reference, context)
     rows = []
     for method in SSW_METHODS:
@@ -391,7 +401,7 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
             {
                 "ssw_lag_us": (when - crossed.T_s) * 1e6,
                 "F_crossed_N": crossed.F_m_N,
-                "reference_shot": int(reference["shot"]),
+                "reference_shot": int(reference.shot),
                 "template_scale": result["scale"],
                 "template_misfit_N": result["misfit"],
                 "ssw_floor_N": result["floor"],
@@ -433,27 +443,35 @@ def is_upper_limit(value_N: float, error_N: float) -> bool:
 def _measure_at_sensor(shot: int, sensor: str, crossed, reference, context: dict) -> dict:
     """:func:`measure_ssw` on the crossed signal at ``sensor`` against the reference
     shot's signal at S2 (the same distance from the launching end)."""
+    bead, ref_bead = context["bead_of"][sensor], context["bead_of"]["S2"]
     _, time, forces = context["signals"][shot]
-    _, ref_time, ref_forces = context["signals"][int(reference["shot"])]
-    ref_force = ref_forces[context["bead_of"]["S2"]]
-    force = forces[context["bead_of"][sensor]]
-    baseline, noise = estimate_baseline(time, force)
-    ref_baseline, ref_noise = estimate_baseline(ref_time, ref_force)
+    _, ref_time, ref_forces = context["signals"][int(reference.shot)]
+    baseline, noise = _baseline(context, shot, bead)
+    ref_baseline, ref_noise = _baseline(context, int(reference.shot), ref_bead)
     return measure_ssw(
         time,
-        force,
+        forces[bead],
         crossed.F_m_N,
         crossed.T_s,
         crossed.tau_s,
         ref_time,
-        ref_force,
-        reference["F_m_N"],
-        reference["T_s"],
+        ref_forces[ref_bead],
+        reference.F_m_N,
+        reference.T_s,
         baseline_N=baseline,
         reference_baseline_N=ref_baseline,
         noise_N=noise,
         reference_noise_N=ref_noise,
     )
+
+
+def _baseline(context: dict, shot: int, bead: int) -> tuple[float, float]:
+    """Baseline and noise (N) of one signal (:func:`estimate_baseline`), found once."""
+    key = (shot, bead)
+    if key not in context["baselines"]:
+        _, time, forces = context["signals"][shot]
+        context["baselines"][key] = estimate_baseline(time, forces[bead])
+    return context["baselines"][key]
 
 
 def _row(base, method, f_m, value, when, reason) -> dict:
