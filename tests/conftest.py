@@ -172,9 +172,9 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.hookimpl(tryfirst=True)
 def pytest_cmdline_main(config: pytest.Config) -> None:
     """``python -m pytest`` runs one worker per core (pytest-xdist's ``-n auto``), each
-    worker given a test or two at a time, in the order of
-    :func:`pytest_collection_modifyitems` (``--maxschedchunk 1``): the long workflow
-    tests first, spread over the workers as they come free.
+    worker given one test at a time beyond its first two (``--maxschedchunk 1``), in
+    the order of :func:`pytest_collection_modifyitems`: the long workflow tests first,
+    spread over the workers as they come free.
 
     Set here, not in ``addopts``, so that ``-p no:xdist`` still parses (a plain serial
     run), and so that an explicit ``-n`` (``-n 0``: serial), ``--dist`` or
@@ -192,23 +192,35 @@ def pytest_cmdline_main(config: pytest.Config) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Tests marked ``workflow`` (Snakemake runs, the longest) first, and of those the
-    first of each module first: it starts the run its module's tests share
-    (:func:`built_once`), so that the workers build different runs at the same time
-    rather than wait for one. The short tests fill the end. Otherwise the collection
-    order (the sort is stable); a serial run sees the same order."""
-    seen: set[str] = set()
+    """Order the tests for the workers; a serial run sees the same order.
 
-    def rank(item: pytest.Item) -> int:
-        if item.get_closest_marker("workflow") is None:
-            return 2
-        module = item.nodeid.split("::")[0]
-        first = module not in seen
-        seen.add(module)
-        return 0 if first else 1
+    xdist gives each worker two tests to start with, then one more as each ends. So the
+    first test of each shared workflow run (:func:`built_once`) goes at positions 0, 2,
+    4, ..., each followed by a short test: every worker starts by building a different
+    run, rather than wait for another's. Then the other tests marked ``workflow``
+    (Snakemake runs, the longest), then the rest, which fill the end. Otherwise the
+    collection order.
+    """
+    runs = {item: _shared_run(item) for item in items}
+    builders = list({run: item for item in reversed(items) if (run := runs[item])}.values())
+    builders.reverse()
+    short = [i for i in items if runs[i] is None and not i.get_closest_marker("workflow")]
+    first = [item for pair in zip(builders, short) for item in pair]
+    chosen = set(first)
+    workflow = [i for i in items if i not in chosen and i.get_closest_marker("workflow")]
+    chosen.update(workflow)
+    items[:] = first + workflow + [i for i in items if i not in chosen]
 
-    ranks = {id(item): rank(item) for item in items}
-    items.sort(key=lambda item: ranks[id(item)])
+
+def _shared_run(item: pytest.Item) -> str | None:
+    """The fixture through which ``item`` uses a run built by :func:`built_once`."""
+    definitions = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
+    if "built_once" not in item.fixturenames:
+        return None
+    for name in item.fixturenames:
+        if any("built_once" in d.argnames for d in definitions.get(name, ())):
+            return name
+    return None
 
 
 def _shared_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
