@@ -1,14 +1,26 @@
-"""Shared fixtures and named tolerances for the physics tests of the simulation core.
+"""Shared fixtures and named tolerances for the physics tests of the simulation core,
+and how the suite runs in parallel.
 
 Every tolerance a physics test asserts against lives here, with the reason for its
 size, so that a reader sees at once how tight each check is. Tests reach them through
 the ``tol`` fixture (no ``import conftest``: robust to pytest's import modes).
+
+The suite runs on every core (pytest-xdist, ``-n auto``) unless told otherwise; see
+:func:`pytest_cmdline_main`. A test file needs nothing for that. A workflow run that
+several tests inspect is built once per session, whichever worker asks first, with
+:func:`built_once` (a module-scoped fixture would be built once per worker); a test
+that changes it works on a copy.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import shutil
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -149,3 +161,191 @@ def peak_of():
 def release_time():
     """``release_time(time, force) -> t``: interpolated opening time of a Hertz contact."""
     return hertz_release_time
+
+
+# ---- the suite on every core (pytest-xdist) -------------------------------------------
+
+#: The checkout (its Snakefile, workflow/ and src/).
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config: pytest.Config) -> None:
+    """``python -m pytest`` runs one worker per core (pytest-xdist's ``-n auto``), each
+    worker given one test at a time beyond its first two (``--maxschedchunk 1``), in
+    the order of :func:`pytest_collection_modifyitems`: the long workflow tests first,
+    spread over the workers as they come free.
+
+    Set here, not in ``addopts``, so that ``-p no:xdist`` still parses (a plain serial
+    run), and so that an explicit ``-n`` (``-n 0``: serial), ``--dist`` or
+    ``--maxschedchunk`` wins, as does ``--pdb``, which needs one process. Runs before
+    xdist's own hook (both tryfirst, a conftest registers later), which turns "auto"
+    into a number.
+    """
+    if not config.pluginmanager.hasplugin("xdist") or hasattr(config, "workerinput"):
+        return
+    option = config.option
+    if option.numprocesses is None and not (option.usepdb or option.collectonly):
+        option.numprocesses = "auto"
+    if getattr(option, "maxschedchunk", 0) is None:
+        option.maxschedchunk = 1
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Order the tests for the workers; a serial run sees the same order.
+
+    xdist gives each worker two tests to start with, then one more as each ends. So the
+    first test of each shared workflow run (:func:`built_once`) goes at positions 0, 2,
+    4, ..., each followed by a short test: every worker starts by building a different
+    run, rather than wait for another's. Then the other tests marked ``workflow``
+    (Snakemake runs, the longest), then the rest, which fill the end. Otherwise the
+    collection order.
+    """
+    runs = {item: _shared_run(item) for item in items}
+    builders = list({run: item for item in reversed(items) if (run := runs[item])}.values())
+    builders.reverse()
+    short = [i for i in items if runs[i] is None and not i.get_closest_marker("workflow")]
+    first = [item for pair in zip(builders, short) for item in pair]
+    chosen = set(first)
+    workflow = [i for i in items if i not in chosen and i.get_closest_marker("workflow")]
+    chosen.update(workflow)
+    items[:] = first + workflow + [i for i in items if i not in chosen]
+
+
+def _shared_run(item: pytest.Item) -> str | None:
+    """The fixture through which ``item`` uses a run built by :func:`built_once`."""
+    definitions = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
+    if "built_once" not in item.fixturenames:
+        return None
+    for name in item.fixturenames:
+        if any("built_once" in d.argnames for d in definitions.get(name, ())):
+            return name
+    return None
+
+
+def _shared_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder of this test session that every xdist worker sees: the parent of the
+    workers' own temporary folders; the session's own one in a serial run."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+@contextlib.contextmanager
+def _exclusive(lock_file: Path) -> Iterator[None]:
+    """Hold an exclusive lock on ``lock_file`` (POSIX ``flock``, as the suite's
+    interruption tests are POSIX-only anyway): one worker at a time gets past it."""
+    import fcntl
+
+    with lock_file.open("a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+@pytest.fixture(scope="session")
+def built_once(tmp_path_factory) -> Callable[[str, Callable[[Path], None]], Path]:
+    """``built_once(name, build) -> folder``: ``build(folder)`` runs once in the whole
+    test session, in the first worker that asks; the others wait for it, then get the
+    same folder. What is built there is shared: a test that changes it works on a copy.
+    A build that fails is not marked done (the next worker tries again and fails the
+    same way, with its own message)."""
+    shared = _shared_folder(tmp_path_factory)
+
+    def once(name: str, build: Callable[[Path], None]) -> Path:
+        folder, done = shared / name, shared / f"{name}.done"
+        with _exclusive(shared / f"{name}.lock"):
+            if not done.exists():
+                shutil.rmtree(folder, ignore_errors=True)
+                folder.mkdir()
+                build(folder)
+                done.touch()
+        return folder
+
+    return once
+
+
+# ---- the library in a workflow run's own folder -----------------------------------------
+
+
+@pytest.fixture(scope="session")
+def copy_library(compiled_kernels) -> Callable[[Path], dict]:
+    """``copy_library(folder) -> env``: the checkout's ``chain`` package copied to
+    ``folder/chain`` with numba's compiled kernels, and :func:`library_env`, the
+    environment under which a Snakemake run imports that copy; a test may edit it.
+
+    numba's cache index checks a source file's time and size, which copy2 keeps: the
+    copy's jobs load the kernels the checkout compiled (:func:`compiled_kernels`)
+    instead of compiling them again, in each job. They are in the copy's __pycache__
+    folders, so a copy of the copy has them too."""
+    source = ROOT / "src" / "chain"
+
+    def copy(folder: Path) -> dict:
+        target = folder / "chain"
+        shutil.copytree(source, target, copy_function=shutil.copy2)
+        if os.environ.get("NUMBA_CACHE_DIR"):
+            # numba then keeps kernels in a folder named by the package's path (CI
+            # caches it): the copy's jobs would compile them again. The same files go
+            # in the copy's __pycache__, where numba looks without NUMBA_CACHE_DIR.
+            _copy_user_numba_cache(source, target, Path(os.environ["NUMBA_CACHE_DIR"]))
+        return library_env(folder)
+
+    return copy
+
+
+def library_env(folder: Path) -> dict:
+    """The environment of a Snakemake run whose jobs import the library copied by
+    :func:`copy_library` into ``folder``: on ``PYTHONPATH``, numba's kernels in-tree."""
+    env = {**os.environ, "PYTHONPATH": str(folder)}
+    env.pop("NUMBA_CACHE_DIR", None)
+    return env
+
+
+@pytest.fixture(scope="session")
+def env_of_library() -> Callable[[Path], dict]:
+    """``env_of_library(folder) -> env``: :func:`library_env` (a library copied earlier,
+    by :func:`copy_library`, perhaps in another worker)."""
+    return library_env
+
+
+def _copy_user_numba_cache(source: Path, target: Path, cache_dir: Path) -> None:
+    """The kernels numba cached for the package ``source`` under NUMBA_CACHE_DIR
+    ``cache_dir``, copied into the __pycache__ folders of its copy ``target``."""
+    from numba.core.caching import _CacheLocator  # how numba names a package's folder
+
+    for folder in sorted({path.parent for path in source.rglob("*.py")}):
+        subpath = _CacheLocator.get_suitable_cache_subpath(str(folder / "_.py"))
+        if (cache_dir / subpath).is_dir():
+            copied = target / folder.relative_to(source) / "__pycache__"
+            shutil.copytree(
+                cache_dir / subpath, copied, copy_function=shutil.copy2, dirs_exist_ok=True
+            )
+
+
+@pytest.fixture(scope="session")
+def compiled_kernels(tmp_path_factory) -> None:
+    """numba's kernels for the kinds of model the workflow runs, compiled into the
+    checkout's cache once for all workers (the first compiles, the others wait and
+    load), before a workflow run copies the library (:func:`copy_library`)."""
+    with _exclusive(_shared_folder(tmp_path_factory) / "kernels.lock"):
+        _run_each_kernel()
+
+
+def _run_each_kernel() -> None:
+    """One short run per kind of model the tests and the workflow's jobs simulate:
+    numba compiles one kernel per kind (Kuwabara-Kono damping, walls, track drag present
+    or not; chain.physics.slopes), and another for a long chain whose beads at rest are
+    skipped (chain.physics.at_rest); or loads it from its cache."""
+    from chain import simulate, uniform_chain
+
+    kinds = [
+        {},
+        {"eta": PAPER_ETA},
+        {"left_wall": True},
+        {"eta": PAPER_ETA, "left_wall": True},
+        {"eta": PAPER_ETA, "drag_rate": 1.0},
+    ]
+    for kind in kinds:
+        simulate(uniform_chain(4, **kind), [0.1], [0.1], duration=1e-5)
+    simulate(uniform_chain(400), [0.1], [0.1], duration=1e-5)

@@ -1,9 +1,10 @@
 """Reproducibility (issue 6): the same bytes from every rebuild, outputs that survive an
 interruption, and numerical guard rails.
 
-Workflow tests (marked ``workflow``) build tests/configs/repro.yaml once in a temporary
-copy of the workflow (Snakefile, workflow/, config.yaml; the library copied and put on
-``PYTHONPATH``, as in test_workflow.py), then
+Workflow tests (marked ``workflow``) build tests/configs/repro.yaml once per test session
+in a temporary copy of the workflow (Snakefile, workflow/, config.yaml; the library
+copied and put on ``PYTHONPATH``, as in test_workflow.py), then, each in its own copy of
+that first build (so that they may run at the same time, in pytest-xdist's workers),
 
 * rebuild it with ``--forceall --cores 2`` and ``--forceall --cores 1``, under other
   ``PYTHONHASHSEED`` values, and require the same bytes in every file of
@@ -91,8 +92,9 @@ RUN = "repro"
 SNAKEMAKE = [sys.executable, "-m", "snakemake", "--configfile", "repro.yaml"]
 #: Top-level entries of results/<run>/ that legitimately hold times: not compared.
 TIMED = ("logs", "benchmarks", "report.html")
-#: Longest a Snakemake call may take, s.
-TIMEOUT = 600
+#: Longest a Snakemake call may take, s: a guard against a hang, far above a build's
+#: minutes on a machine shared with other workers (pytest-xdist) or other work.
+TIMEOUT = 1800
 
 
 # ---- the workflow in a temporary directory ----------------------------------------
@@ -100,16 +102,18 @@ TIMEOUT = 600
 
 @dataclass(frozen=True)
 class Workspace:
-    base: Path  # temporary directory: work/, lib/, reference/
+    base: Path  # temporary directory: work/, lib/
     work: Path  # Snakemake's working directory (a copy of the workflow)
     env: dict
+    reference: Path  # the first build's results, for the failure messages
 
     @property
     def out(self) -> Path:
         return self.work / "results" / RUN
 
 
-def make_workspace(base: Path) -> Workspace:
+def make_workspace(base: Path, copy_library) -> None:
+    """The workflow and the repro config in ``base``/work, the library in ``base``/lib."""
     work = base / "work"
     work.mkdir()
     for name in ("Snakefile", "config.yaml"):
@@ -118,9 +122,20 @@ def make_workspace(base: Path) -> Workspace:
         ROOT / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__")
     )
     shutil.copy2(CONFIG, work / "repro.yaml")
-    # copy2 keeps mtimes, so numba's cache of the integrator stays valid in the copy.
-    shutil.copytree(ROOT / "src" / "chain", base / "lib" / "chain", copy_function=shutil.copy2)
-    return Workspace(base, work, {**os.environ, "PYTHONPATH": str(base / "lib")})
+    copy_library(base / "lib")  # with numba's compiled kernels (conftest.py)
+
+
+def workspace(base: Path, env_of_library) -> Workspace:
+    """The workspace :func:`make_workspace` made in ``base``."""
+    return Workspace(base, base / "work", env_of_library(base / "lib"), base / "reference")
+
+
+def copy_workspace(ws: Workspace, base: Path, env_of_library) -> Workspace:
+    """A copy of ``ws`` in ``base``: the workflow with its results and Snakemake's
+    records, and the library with its compiled kernels; copy2 keeps the files' times."""
+    for part in ("work", "lib"):
+        shutil.copytree(ws.base / part, base / part, symlinks=True, copy_function=shutil.copy2)
+    return Workspace(base, base / "work", env_of_library(base / "lib"), ws.reference)
 
 
 def snakemake(ws: Workspace, *args, env: dict | None = None) -> subprocess.CompletedProcess:
@@ -191,26 +206,41 @@ INTERMEDIATES = ("simulation/", "experiment/", "ablation/")
 def assert_same_bytes(
     ws: Workspace, expected: dict, what: str, may_be_missing: tuple[str, ...] = ()
 ) -> None:
-    diffs = differences(expected, digest(ws.out), ws.base / "reference", ws.out)
+    diffs = differences(expected, digest(ws.out), ws.reference, ws.out)
     diffs = [d for d in diffs if not d.startswith(tuple(f"missing: {p}" for p in may_be_missing))]
     assert not diffs, f"{what}: {len(diffs)} file(s) differ from the first build:\n" + "\n".join(
         diffs
     )
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    """Run 1: the repro config built from nothing with --cores 2; (workspace, digest).
-    A copy of its results is kept in <base>/reference for the failure messages."""
-    ws = make_workspace(tmp_path_factory.mktemp("repro"))
-    result = snakemake(ws, "--cores", "2")
-    assert result.returncode == 0, tail(result)
-    shutil.copytree(ws.out, ws.base / "reference", ignore=shutil.ignore_patterns(*TIMED))
-    expected = digest(ws.out)
+@pytest.fixture(scope="session")
+def built(built_once, copy_library, env_of_library):
+    """Run 1: the repro config built from nothing with --cores 2, once per test session;
+    (workspace, digest). A copy of its results is kept in <base>/reference, the digest's
+    source and the failure messages' reference. Tests that build again do so in a copy
+    (:func:`rebuilt`)."""
+
+    def build(base: Path) -> None:
+        make_workspace(base, copy_library)
+        ws = workspace(base, env_of_library)
+        result = snakemake(ws, "--cores", "2")
+        assert result.returncode == 0, tail(result)
+        shutil.copytree(ws.out, ws.reference, ignore=shutil.ignore_patterns(*TIMED))
+
+    ws = workspace(built_once("repro", build), env_of_library)
+    expected = digest(ws.reference)
+    assert expected == digest(ws.out)
     assert any(f.startswith("figures/") and f.endswith(".pdf") for f in expected), expected
     assert "summary.json" in expected and "tables/delay_fits.csv" in expected, expected
     assert any(f.startswith("experiment/raw/") for f in expected), "no virtual experiment ran"
     return ws, expected
+
+
+@pytest.fixture
+def rebuilt(built, tmp_path, env_of_library):
+    """(a copy of run 1's workspace, run 1's digest), for a test that builds again."""
+    ws, expected = built
+    return copy_workspace(ws, tmp_path, env_of_library), expected
 
 
 # ---- part 1: same bytes --------------------------------------------------------------
@@ -218,10 +248,10 @@ def built(tmp_path_factory):
 
 @pytest.mark.workflow
 @pytest.mark.parametrize(("cores", "hash_seed"), [("2", "1"), ("1", "2")], ids=["cores2", "cores1"])
-def test_forced_rebuild_gives_the_same_bytes(built, cores, hash_seed):
+def test_forced_rebuild_gives_the_same_bytes(rebuilt, cores, hash_seed):
     """Run 2 (--forceall --cores 2) and run 3 (--forceall --cores 1), each under another
     string-hash seed than run 1, rewrite every file with the same bytes."""
-    ws, expected = built
+    ws, expected = rebuilt
     start = time.time_ns()
     result = snakemake(
         ws, "--forceall", "--cores", cores, env={**ws.env, "PYTHONHASHSEED": hash_seed}
@@ -419,14 +449,14 @@ def resume(ws: Workspace, expected: dict, how: str) -> None:
     ],
     ids=["ctrl-c-then-crash", "sigterm-snakemake-then-group"],
 )
-def test_interrupted_rebuild_resumes_to_the_same_bytes(built, first, second):
+def test_interrupted_rebuild_resumes_to_the_same_bytes(rebuilt, first, second):
     """A forced rebuild interrupted (``first``) while the simulations are being written,
     then the user's command; a forced rebuild interrupted (``second``) while the tables
     are being written, then the user's command: the same bytes as an uninterrupted
     build, and after each interruption every file under its final name is a complete
     one. (Each interruption hits a full forced rebuild, so that the run cannot end
     before the watched files are written, whatever the machine's speed.)"""
-    ws, expected = built
+    ws, expected = rebuilt
     interrupted_run(ws, expected, ["--forceall", "--cores", "2"], "simulation", first)
     resume(ws, expected, first)
     # Snakemake deletes the outputs of the jobs it killed; the rerun does not remake

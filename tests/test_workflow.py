@@ -82,7 +82,12 @@ def env() -> dict:
     return dict(os.environ)
 
 
-def run(args, work: Path, env: dict, timeout=600) -> subprocess.CompletedProcess:
+#: Longest a Snakemake call may take, s: a guard against a hang, far above a tiny run's
+#: minutes on a machine shared with other workers (pytest-xdist) or other work.
+TIMEOUT = 1800
+
+
+def run(args, work: Path, env: dict, timeout=TIMEOUT) -> subprocess.CompletedProcess:
     """Snakemake in ``work``, with the work tree's own Snakefile if it has one (a copied
     checkout), else the repository's."""
     snakefile = work / "Snakefile" if (work / "Snakefile").exists() else ROOT / "Snakefile"
@@ -106,23 +111,38 @@ def planned_jobs(work: Path, env: dict) -> dict[str, int]:
     return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", table, re.M)}
 
 
-@pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    """The tiny run, done once in a copy of the checkout (Snakefile, workflow, config,
-    library), so that tests can edit its library: (work directory, results directory,
-    env, library folder)."""
-    work = tmp_path_factory.mktemp("workflow") / "checkout"
-    work.mkdir()
-    for name in ("config.yaml", "Snakefile"):
-        shutil.copy(ROOT / name, work / name)
-    shutil.copytree(ROOT / "workflow", work / "workflow", ignore=IGNORED)
-    library = work / "src" / "chain"
-    # copy2 keeps mtimes, so numba's cache of the integrator stays valid in the copy.
-    shutil.copytree(ROOT / "src" / "chain", library, copy_function=shutil.copy2)
+@pytest.fixture(scope="session")
+def tiny(built_once, copy_library):
+    """The tiny run, done once per test session in a copy of the checkout (Snakefile,
+    workflow, config, library): (work directory, results directory, env, library folder).
+    Shared by every test that asks for it: a test that edits the copy edits a copy of
+    it (:func:`checkout_copy`)."""
+
+    def build(folder: Path) -> None:
+        work = folder / "checkout"
+        work.mkdir()
+        for name in ("config.yaml", "Snakefile"):
+            shutil.copy(ROOT / name, work / name)
+        shutil.copytree(ROOT / "workflow", work / "workflow", ignore=IGNORED)
+        result = run(["--cores", "2", "--configfile", str(TINY)], work, copy_library(work / "src"))
+        assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+
+    return checkout(built_once("tiny", build) / "checkout")
+
+
+def checkout(work: Path) -> tuple[Path, Path, dict, Path]:
+    """(work directory, results directory, env, library folder) of a tiny run's checkout:
+    its jobs import the library copied into it (``src/chain``)."""
     env = {**os.environ, "PYTHONPATH": str(work / "src")}
-    result = run(["--cores", "2", "--configfile", str(TINY)], work, env)
-    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
-    return work, work / "results" / "tiny", env, library
+    return work, work / "results" / "tiny", env, work / "src" / "chain"
+
+
+def checkout_copy(work: Path, folder: Path) -> tuple[Path, Path, dict, Path]:
+    """A copy of the tiny run's checkout in ``folder``, results and Snakemake's records
+    included (copy2 keeps the times that tell Snakemake what is up to date)."""
+    copy = folder / "elsewhere" / "checkout"
+    shutil.copytree(work, copy, symlinks=True, copy_function=shutil.copy2)
+    return checkout(copy)
 
 
 def test_contract_files_and_columns(tiny):
@@ -311,17 +331,13 @@ def test_second_run_has_nothing_to_do(tiny):
          set()),
     ],
 )  # fmt: skip
-def test_editing_the_library_reruns_what_depends_on_it(tiny, module, expected, untouched):
-    work, _, env, library = tiny
+def test_editing_the_library_reruns_what_depends_on_it(tiny, tmp_path, module, expected, untouched):
+    # In a copy of the built checkout: the tiny run itself is shared with other tests.
+    work, _, env, library = checkout_copy(tiny[0], tmp_path)
     path = library / f"{module}.py"
-    original, stat = path.read_bytes(), path.stat()
-    try:
-        # An edit, not a touch: Snakemake reruns only when the content changed.
-        path.write_bytes(original + b"\n# an edit\n")
-        jobs = planned_jobs(work, env)
-    finally:
-        path.write_bytes(original)
-        os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    # An edit, not a touch: Snakemake reruns only when the content changed.
+    path.write_bytes(path.read_bytes() + b"\n# an edit\n")
+    jobs = planned_jobs(work, env)
     if untouched is None:
         assert set(jobs) == expected, jobs
     else:
@@ -336,29 +352,29 @@ def test_editing_the_library_reruns_what_depends_on_it(tiny, module, expected, u
 def test_a_copied_checkout_has_nothing_to_do(tiny, tmp_path):
     """The rules name the library by paths relative to the working directory, so a
     built run copied elsewhere (a CI cache, a colleague's copy) is up to date there."""
-    work, _, _, _ = tiny
-    copy = tmp_path / "elsewhere" / "checkout"
-    shutil.copytree(work, copy, symlinks=True, copy_function=shutil.copy2)
-    assert planned_jobs(copy, {**os.environ, "PYTHONPATH": str(copy / "src")}) == {}
+    copy, _, env, _ = checkout_copy(tiny[0], tmp_path)
+    assert planned_jobs(copy, env) == {}
 
 
-@pytest.fixture(scope="module")
-def measured(tmp_path_factory):
-    """The tiny run on the committed dataset, read as a lab's measured dataset."""
-    work = tmp_path_factory.mktemp("measured") / "work"
-    work.mkdir()
-    shutil.copy(ROOT / "config.yaml", work / "config.yaml")
-    shutil.copytree(ROOT / DATASET, work / DATASET)
-    out = work / "results" / "tiny_measured"
-    # The experiment's part of the pipeline: tables, Fig. 2 and the summary (Fig. 1, 3-5
-    # are the tiny run's business).
-    targets = [  # relative to the working directory, as Snakemake names its outputs
-        "results/tiny_measured/summary.json",
-        "results/tiny_measured/figures/fig2_experiment_traces.png",
-    ]
-    result = run([*targets, "--cores", "2", "--configfile", str(TINY_MEASURED)], work, env())
-    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
-    return out
+@pytest.fixture(scope="session")
+def measured(built_once):
+    """The tiny run on the committed dataset, read as a lab's measured dataset (done once
+    per test session)."""
+
+    def build(work: Path) -> None:
+        shutil.copy(ROOT / "config.yaml", work / "config.yaml")
+        shutil.copytree(ROOT / DATASET, work / DATASET)
+        # The experiment's part of the pipeline: tables, Fig. 2 and the summary (Fig. 1,
+        # 3-5 are the tiny run's business); relative to the working directory, as
+        # Snakemake names its outputs.
+        targets = [
+            "results/tiny_measured/summary.json",
+            "results/tiny_measured/figures/fig2_experiment_traces.png",
+        ]
+        result = run([*targets, "--cores", "2", "--configfile", str(TINY_MEASURED)], work, env())
+        assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+
+    return built_once("measured", build) / "results" / "tiny_measured"
 
 
 def test_measured_dataset_runs_the_same_analysis(measured):
