@@ -114,7 +114,7 @@ def integrate_launch(u, v, params, dt, n_steps, record_every, links, particles, 
     u, v : (P,) arrays
         Initial displacements, m, and velocities, m/s; they end as the final state.
     params : tuple
-        The kernel's model arrays (:func:`chain.physics.integrator._lean_params`).
+        The kernel's model arrays (:func:`chain.physics.launches._lean_params`).
     dt : float
         Step, s.
     n_steps, record_every : int
