@@ -11,10 +11,10 @@ import pytest
 from chain.errors import ParameterError
 from chain.physics.lammps_engine import (
     GranularChain,
-    lammps_available,
     run_granular_chain,
     viscoelastic_damping_coefficient,
 )
+from chain.physics.lammps_library import lammps_available
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
 from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate

@@ -26,7 +26,7 @@ import numpy as np
 
 from chain.apparatus.virtual_settings import VirtualExperiment
 from chain.labels import VIRTUAL_SERIES
-from chain.physics.lammps_engine import lammps_available
+from chain.physics.lammps_library import lammps_available
 from chain.physics.model import ChainModel
 from chain.pipeline.ablation_config import ablation_variants, variant_settings, variant_tolerance
 from chain.pipeline.datasets import ExperimentPart, experiment_label, experiment_parts
