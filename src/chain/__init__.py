@@ -38,7 +38,7 @@ __getattr__, __dir__, __all__ = lazy_exports(
         "TraceFormatError": "chain.traces",
         "build_chain": "chain.physics.model",
         "contact_stiffness": "chain.physics.materials",
-        "default_time_step": "chain.physics.simulation",
+        "default_time_step": "chain.physics.time_step",
         "delay_fit_table": "chain.analysis.delays",
         "delay_table": "chain.analysis.delays",
         "find_pulses": "chain.analysis.pulses",

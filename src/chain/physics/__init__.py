@@ -34,8 +34,8 @@ __getattr__, __dir__, __all__ = lazy_exports(
             ["IntegrationError", "integrate", "integrate_many"], "chain.physics.integrator"
         ),
         **dict.fromkeys(
-            ["SimulationResult", "default_time_step", "simulate", "simulate_many"],
-            "chain.physics.simulation",
+            ["SimulationResult", "simulate", "simulate_many"], "chain.physics.simulation"
         ),
+        "default_time_step": "chain.physics.time_step",
     },
 )

@@ -22,8 +22,8 @@ import numpy as np
 
 from chain.analysis.pulses import DEFAULT_MIN_SNR
 from chain.physics.materials import get_material, sphere_mass
-from chain.physics.simulation import STEPS_PER_SPRING_PERIOD
 from chain.physics.theory import LAUNCH_VELOCITY_RATIO, force_from_bead_velocity
+from chain.physics.time_step import STEPS_PER_SPRING_PERIOD
 from chain.pipeline.config_bounds_run import (
     MIN_SENSOR_DISTANCE,
     check_passing,
