@@ -62,11 +62,12 @@ from measure import c_run as c_run_equal
 from scipy.integrate import solve_ivp
 
 from chain.physics import kernels
+from chain.physics.builders import uniform_chain
 from chain.physics.integrator import integrate
 from chain.physics.kernels import EVENT_AFTERMATH, EVENT_SUBSTEPS, _integrate_one
 from chain.physics.launches import _lean_params, _outputs
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
-from chain.physics.model import launch_velocities, uniform_chain
+from chain.physics.model import launch_velocities
 from chain.physics.simulation import default_time_step, simulate
 
 N_BEADS = 26

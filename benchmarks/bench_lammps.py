@@ -24,9 +24,9 @@ import time
 
 import numpy as np
 
+from chain.physics.builders import uniform_chain
 from chain.physics.lammps_engine import GranularChain, run_granular_chain
 from chain.physics.materials import STEEL_100C6
-from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
 
 RADIUS = 13e-3

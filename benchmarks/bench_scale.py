@@ -41,7 +41,7 @@ RECORD_INTERVAL = 1e-6  # s
 
 def one(n_beads: int, duration: float, sensors_only: bool, repeat: int) -> dict:
     """Run the benchmark for ``n_beads`` in this process; returns the figures."""
-    from chain.physics.model import uniform_chain
+    from chain.physics.builders import uniform_chain
     from chain.physics.simulation import default_time_step, simulate
 
     sensors = (n_beads // 3, 2 * n_beads // 3)

@@ -41,15 +41,16 @@ import numba
 import numpy as np
 from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, c_run, load_c, machine
 
+from chain.physics.builders import uniform_chain
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
-from chain.physics.model import launch_velocities, uniform_chain
+from chain.physics.model import launch_velocities
 from chain.physics.simulation import DEFAULT_RECORD_INTERVAL, felt_contacts, simulate_many
 
 RADIUS = 13e-3  # m, the paper's beads
 SPEEDS = (0.05, 1.0)  # m/s, range of V0
 JOB_START = (
     "import time; t = time.perf_counter(); "
-    "from chain.physics.model import uniform_chain; "
+    "from chain.physics.builders import uniform_chain; "
     "from chain.physics.simulation import simulate; "
     "simulate(uniform_chain(20), 0.3, 0.3, duration=1e-5, contacts=(), beads=()); "
     "print(time.perf_counter() - t)"

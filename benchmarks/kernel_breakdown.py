@@ -41,9 +41,10 @@ from bench_integrator import c_run, dop853, patched_kernel
 from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, load_c
 
 from chain.physics import kernels
+from chain.physics.builders import uniform_chain
 from chain.physics.integrator import integrate
 from chain.physics.launches import _lean_params, _outputs
-from chain.physics.model import launch_velocities, uniform_chain
+from chain.physics.model import launch_velocities
 from chain.physics.simulation import default_time_step, simulate
 
 N_BEADS = 26

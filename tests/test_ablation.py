@@ -15,7 +15,7 @@ from snakemake.utils import validate
 
 from chain.apparatus.virtual import VirtualExperiment, plan_shots, simulate_virtual_shots
 from chain.errors import ConfigError, ParameterError
-from chain.physics.model import uniform_chain
+from chain.physics.builders import uniform_chain
 from chain.physics.simulation import simulate
 from chain.pipeline.ablation_config import (
     ablation_variants,

@@ -10,7 +10,7 @@ import yaml
 from snakemake.utils import validate
 
 from chain.apparatus.shots import simulate_shots
-from chain.physics.model import uniform_chain
+from chain.physics.builders import uniform_chain
 from chain.pipeline.plan import launch_speeds
 from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
 from chain.report.numbers.spread import ablation_summary, c_spread_summary

@@ -9,7 +9,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.analysis.ssw_track import field_table, ssw_track_table
-from chain.physics.model import uniform_chain
+from chain.physics.builders import uniform_chain
 from chain.physics.simulation import simulate
 from chain.report.figures.fig_ssw_spacetime import fig_ssw_spacetime
 from chain.report.figures.style import save_figure

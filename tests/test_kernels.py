@@ -12,8 +12,9 @@ import numba
 import numpy as np
 import pytest
 
+from chain.physics.builders import uniform_chain
 from chain.physics.integrator import integrate
-from chain.physics.model import launch_velocities, uniform_chain
+from chain.physics.model import launch_velocities
 from chain.physics.simulation import default_time_step
 
 FIELDS = (

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from chain.errors import ParameterError
+from chain.physics.builders import uniform_chain
 from chain.physics.lammps_engine import (
     GranularChain,
     run_granular_chain,
@@ -16,7 +17,6 @@ from chain.physics.lammps_engine import (
 )
 from chain.physics.lammps_library import lammps_available
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
-from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
 
 RADIUS = 13e-3

@@ -18,8 +18,8 @@ from snakemake.utils import validate
 from chain.apparatus.virtual import VirtualExperiment, plan_shots
 from chain.apparatus.virtual_shots import apparatus_chain, chain_draws, rest_displacement
 from chain.errors import ParameterError
+from chain.physics.builders import uniform_chain
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
-from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
 from chain.report.numbers.mechanisms import candidate_sentence, friction_sentence
 from chain.studies.mechanism_settings import candidate_variants, setting_name, sweep_settings

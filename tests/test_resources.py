@@ -10,8 +10,8 @@ import textwrap
 import pytest
 
 from chain.errors import ParameterError
+from chain.physics.builders import uniform_chain
 from chain.physics.materials import get_material
-from chain.physics.model import uniform_chain
 from chain.pipeline.resources import (
     BASE_MB,
     BYTES_PER_BEAD_SAMPLE,
@@ -68,7 +68,7 @@ _MEASURE = textwrap.dedent(
     import numpy as np
     from chain.apparatus.shots import simulate_shots
     from chain.physics.materials import get_material
-    from chain.physics.model import uniform_chain
+    from chain.physics.builders import uniform_chain
     from chain.traces import write_traces
     n, launches, duration = 40, 8, 3.0e-3
     speeds = np.geomspace(0.05, 1.0, launches)

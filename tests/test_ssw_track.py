@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 
 from chain.analysis.ssw_speed import ssw_speed_table
 from chain.analysis.ssw_track import ssw_track_table, track_collision
+from chain.physics.builders import uniform_chain
 from chain.physics.materials import STEEL_100C6
-from chain.physics.model import uniform_chain
 from chain.physics.simulation import simulate
 from chain.physics.theory import cos6_pulse, nesterenko_speed_from_force
 

@@ -13,9 +13,10 @@ from collections.abc import Mapping, Sequence
 
 from chain.apparatus.shots import trace_table
 from chain.errors import ParameterError, check_bead_numbers, require_positive
+from chain.physics.builders import uniform_chain
 from chain.physics.integrator import IntegrationError
 from chain.physics.materials import MATERIALS, get_material
-from chain.physics.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS, uniform_chain
+from chain.physics.model import PAPER_BEAD_RADIUS, PCB_200B02_STIFFNESS
 from chain.physics.simulation import DEFAULT_RECORD_INTERVAL, felt_contacts, simulate
 from chain.traces import TraceFormatError, write_traces
 

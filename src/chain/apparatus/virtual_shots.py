@@ -10,8 +10,9 @@ import numpy as np
 import pandas as pd
 
 from chain.apparatus.virtual_settings import CHAIN_STREAM, VirtualExperiment, check_switches
+from chain.physics.builders import build_chain, uniform_chain
 from chain.physics.materials import contact_stiffness, sphere_mass
-from chain.physics.model import ChainModel, Striker, build_chain, uniform_chain
+from chain.physics.model import ChainModel, Striker
 from chain.physics.simulation import default_time_step, felt_contacts, simulate
 
 #: The virtual experiment integrates with this many times the conservative default step

@@ -20,16 +20,10 @@ __getattr__, __dir__, __all__ = lazy_exports(
             "chain.physics.materials",
         ),
         **dict.fromkeys(
-            [
-                "PCB_200B02_STIFFNESS",
-                "ChainModel",
-                "Striker",
-                "build_chain",
-                "launch_velocities",
-                "uniform_chain",
-            ],
+            ["PCB_200B02_STIFFNESS", "ChainModel", "Striker", "launch_velocities"],
             "chain.physics.model",
         ),
+        **dict.fromkeys(["build_chain", "uniform_chain"], "chain.physics.builders"),
         **dict.fromkeys(
             ["IntegrationError", "integrate", "integrate_many"], "chain.physics.integrator"
         ),

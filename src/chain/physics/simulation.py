@@ -160,7 +160,7 @@ def simulate(
     Parameters
     ----------
     model : ChainModel
-        The chain (see :func:`chain.physics.model.uniform_chain`).
+        The chain (see :func:`chain.physics.builders.uniform_chain`).
     v_left : float or array of B floats
         Speed given to bead 1 (or the left striker), moving right, m/s.
     v_right : float or array of B floats

@@ -32,8 +32,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from chain.physics.builders import uniform_chain
 from chain.physics.materials import get_material
-from chain.physics.model import ChainModel, uniform_chain
+from chain.physics.model import ChainModel
 
 #: The keys of a job's inputs, in order.
 JOB_KEYS = (

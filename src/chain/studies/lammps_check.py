@@ -15,8 +15,8 @@ import pandas as pd
 
 from chain.apparatus.lammps_shots import lammps_shots
 from chain.apparatus.shots import shot_time_step, simulate_shots
+from chain.physics.builders import uniform_chain
 from chain.physics.materials import get_material
-from chain.physics.model import uniform_chain
 from chain.studies.mechanism_fits import analyse_traces
 from chain.studies.mechanism_settings import granular_chain
 
