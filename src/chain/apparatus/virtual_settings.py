@@ -12,11 +12,8 @@ import numpy as np
 import yaml
 
 from chain.apparatus.acquisition import PCB_200B02_SENSITIVITY_MV_PER_N, check_adc_bits
-from chain.apparatus.measured import (
-    METADATA_FILE,
-    impact_speed_from_drop_height,
-    read_metadata,
-)
+from chain.apparatus.measured_format import METADATA_FILE
+from chain.apparatus.metadata import impact_speed_from_drop_height, read_metadata
 from chain.errors import (
     ParameterError,
     check_bead_numbers,

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from chain.apparatus.virtual import VirtualExperiment, check_switches
+from chain.apparatus.virtual_settings import VirtualExperiment, check_switches
 from chain.errors import ConfigError, ParameterError
 from chain.errors import key_label as key_name
 from chain.pipeline.virtual_config import VIRTUAL_KEYS, virtual_experiment_settings
