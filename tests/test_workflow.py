@@ -310,12 +310,11 @@ def test_second_run_has_nothing_to_do(tiny):
     ("module", "expected", "untouched"),
     [
         # None: exactly the expected jobs, nothing else (the article embeds every figure).
-        ("report/style", set(FIGURES) | {"article", "all"}, None),
-        ("report/fig4_delay_vs_force", {"fig4_delay_vs_force", "article", "all"}, None),
-        ("report/trace_panels", {"fig2_experiment_traces", "fig3_simulation_traces", "article",
-                                 "all"},
-         None),
-        ("report/summary_md", {"summary_md", "all"}, None),
+        ("report/figures/style", set(FIGURES) | {"article", "all"}, None),
+        ("report/figures/fig4_delay_vs_force", {"fig4_delay_vs_force", "article", "all"}, None),
+        ("report/figures/trace_panels",
+         {"fig2_experiment_traces", "fig3_simulation_traces", "article", "all"}, None),
+        ("report/text/markdown", {"summary_md", "all"}, None),
         ("analysis/ssw", {"ssw", "ssw_fits", "fig2_experiment_traces", "fig3_simulation_traces",
                           "fig5_ssw_vs_force", "summary"},
          {"simulate", "virtual_experiment", "experiment_traces", "pulses", "selection",
