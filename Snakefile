@@ -41,3 +41,7 @@ include: "workflow/rules/article.smk"
 include: "workflow/rules/sweep.smk"
 include: "workflow/rules/ablation.smk"
 include: "workflow/rules/mechanisms.smk"
+
+
+# After every rule: no cached rule may share one result between two of its jobs.
+check_reused_rules(workflow.rules)

@@ -89,10 +89,12 @@ TIMEOUT = 1800
 
 def run(args, work: Path, env: dict, timeout=TIMEOUT) -> subprocess.CompletedProcess:
     """Snakemake in ``work``, with the work tree's own Snakefile if it has one (a copied
-    checkout), else the repository's."""
+    checkout), else the repository's; started in ``work``, as a user would, so that the
+    workflow profile is the work tree's (profiles/default), wherever pytest started."""
     snakefile = work / "Snakefile" if (work / "Snakefile").exists() else ROOT / "Snakefile"
     return subprocess.run(
         [*SNAKEMAKE, "--snakefile", str(snakefile), "--directory", str(work), *args],
+        cwd=work,
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -123,7 +125,8 @@ def tiny(built_once, copy_library):
         work.mkdir()
         for name in ("config.yaml", "Snakefile"):
             shutil.copy(ROOT / name, work / name)
-        shutil.copytree(ROOT / "workflow", work / "workflow", ignore=IGNORED)
+        for folder in ("workflow", "profiles"):
+            shutil.copytree(ROOT / folder, work / folder, ignore=IGNORED)
         result = run(["--cores", "2", "--configfile", str(TINY)], work, copy_library(work / "src"))
         assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
 
@@ -180,7 +183,6 @@ def test_virtual_experiment_and_selection(tiny):
         traces = pd.read_csv(out / "experiment" / f"virtual_N{n}_traces.csv")
         assert set(traces["source"]) == {"experiment"} and set(traces["N"]) == {n}
         assert (out / "logs" / "experiment" / f"virtual_N{n}.log").exists()
-        assert (out / "benchmarks" / "experiment" / f"virtual_N{n}.tsv").exists()
     assert (
         "virtual_N17_traces.csv: 6 collision and 3 reference shots"
         in (out / "logs" / "experiment" / "traces.log").read_text()
@@ -219,7 +221,7 @@ def test_fits_cover_every_model_and_chain(tiny):
     assert len(ssw_fits) == 4 + 2
 
 
-def test_simulation_outputs_logs_and_benchmarks(tiny):
+def test_simulation_outputs_and_logs(tiny):
     _, out, _, _ = tiny
     for model in ("elastic", "viscoelastic"):
         for n in (16, 17):
@@ -231,7 +233,6 @@ def test_simulation_outputs_logs_and_benchmarks(tiny):
             runs = pd.read_csv(out / "simulation" / f"{model}_N{n}_runs.csv")
             assert len(runs) == 2 * 4  # collision + reference per speed
             assert (runs["energy_drift"] < 1e-6).all()
-            assert (out / "benchmarks" / "simulate" / f"{model}_N{n}.tsv").exists()
             log = (out / "logs" / "simulate" / f"{model}_N{n}.log").read_text()
             assert "energy drift" in log
     assert (out / "logs" / "summary.log").exists()
@@ -353,6 +354,93 @@ def test_a_copied_checkout_has_nothing_to_do(tiny, tmp_path):
     built run copied elsewhere (a CI cache, a colleague's copy) is up to date there."""
     copy, _, env, _ = checkout_copy(tiny[0], tmp_path)
     assert planned_jobs(copy, env) == {}
+
+
+# ---- reuse across runs (issue 33; chain.pipeline.reuse) ----------------------------
+
+#: What a run states about itself (its name, provenance): made anew by every run.
+PER_RUN_LOGS = {"summary.log", "summary_md.log", "article.log"}
+#: Files a run writes about itself or its times (and logs/, benchmarks/); every other
+#: file is a result.
+PER_RUN_FILES = ("summary.json", "summary.md", "article.pdf", ".snakemake_timestamp")
+
+
+def ran(out: Path) -> set[str]:
+    """Logs (relative to logs/) of the jobs that ran: a job whose result was reused from
+    results/.cache never starts, and its log stays empty."""
+    logs = out / "logs"
+    return {str(p.relative_to(logs)) for p in logs.rglob("*.log") if p.stat().st_size > 0}
+
+
+def differing_results(a: Path, b: Path) -> list[str]:
+    """Result files of run folder ``a`` missing from ``b`` or with other bytes there."""
+    names = [
+        p.relative_to(a)
+        for p in sorted(a.rglob("*"))
+        if p.is_file()
+        and not {"logs", "benchmarks"} & set(p.relative_to(a).parts)
+        and p.name not in PER_RUN_FILES
+    ]
+    assert len(names) > 50, names  # tables, figures, traces, the virtual datasets
+    return [
+        str(n)
+        for n in names
+        if not (b / n).is_file() or (a / n).read_bytes() != (b / n).read_bytes()
+    ]
+
+
+def same_summary(a: Path, b: Path) -> bool:
+    """summary.json of two runs equal but for the run's name and provenance."""
+    first, second = (json.loads((folder / "summary.json").read_text()) for folder in (a, b))
+    for summary in (first, second):
+        summary.pop("run_name"), summary.pop("provenance")
+    return first == second
+
+
+def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
+    """The same config under another run name runs no job but those stating the run, and
+    its results are the first run's bytes."""
+    work, out, env, _ = checkout_copy(tiny[0], tmp_path)
+    result = run(
+        ["--cores", "2", "--configfile", str(TINY), "--config", "run_name=again"], work, env
+    )
+    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    again = work / "results" / "again"
+    assert ran(again) == PER_RUN_LOGS
+    assert "from cache" in result.stdout + result.stderr
+    assert differing_results(out, again) == [] and same_summary(out, again)
+
+
+def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
+    """A what-if changing only an analysis key reuses every simulation, the virtual
+    experiment and the tracks; the analysis the key changes runs again."""
+    work, _, env, _ = checkout_copy(tiny[0], tmp_path)
+    overlay = tmp_path / "peak.yaml"
+    overlay.write_text("run_name: peak\nanalysis:\n  main_estimator: peak\n")
+    args = ["--cores", "2", "--configfile", str(TINY), str(overlay)]
+    result = run(args, work, env)
+    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    jobs = ran(work / "results" / "peak")
+    simulations = {j for j in jobs if j.startswith(("simulate/", "lammps/", "experiment/virtual"))}
+    assert simulations == set(), jobs
+    assert {"tables/ssw.log", "experiment/selection.log"} <= jobs, jobs
+    assert "tables/pulses.log" not in jobs  # every estimator's pulses are computed anyway
+
+
+def test_a_reused_result_is_the_recomputed_one(tiny, tmp_path):
+    """``reuse: false`` computes every job anew and stores nothing; the bytes are those
+    the cache holds (the tiny run's results are links into it)."""
+    work, out, env, _ = checkout_copy(tiny[0], tmp_path)
+    cache = work / "results" / ".cache"
+    stored = sorted(p.name for p in cache.iterdir())
+    assert any(p.is_symlink() for p in out.rglob("*"))  # the tiny run's results are stored
+    args = ["--cores", "2", "--configfile", str(TINY), "--config", "run_name=fresh", "reuse=False"]
+    result = run(args, work, env)
+    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    fresh = work / "results" / "fresh"
+    assert not any(p.is_symlink() for p in fresh.rglob("*"))
+    assert sorted(p.name for p in cache.iterdir()) == stored
+    assert differing_results(out, fresh) == [] and same_summary(out, fresh)
 
 
 @pytest.fixture(scope="session")

@@ -24,8 +24,7 @@ rule ablation_variant:
         ssw_fits=f"{OUT}/ablation/{{variant}}_ssw_fits.csv",
     log:
         f"{LOGS}/ablation/{{variant}}.log",
-    benchmark:
-        f"{BENCH}/ablation/{{variant}}.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
@@ -34,6 +33,8 @@ rule ablation_variant:
         tolerance=ablation_tolerance,
         estimators=[config["analysis"]["main_estimator"]],
         series=PLAN.virtual_name,
+        software=SOFTWARE,
+        variant=restate("variant"),
     script:
         "../scripts/ablation_variant.py"
 
@@ -48,14 +49,15 @@ rule ablation_table:
         f"{TABLES}/ablation_exponent{{which}}.csv",
     log:
         f"{LOGS}/tables/ablation_exponent{{which}}.log",
-    benchmark:
-        f"{BENCH}/tables/ablation_exponent{{which}}.tsv"
     wildcard_constraints:
         which="|_all",
+    cache: REUSE
     conda:
         ENV
     params:
         variants=lambda wildcards: ablation_names(wildcards.which),
         overrides={name: overrides_text(v) for name, v in PLAN.ablation.items()},
+        software=SOFTWARE,
+        which=restate("which"),
     script:
         "../scripts/ablation_table.py"

@@ -14,8 +14,7 @@ rule pulses:
         ),
     log:
         f"{LOGS}/tables/pulses.log",
-    benchmark:
-        f"{BENCH}/tables/pulses.tsv"
+    cache: REUSE
     priority: 2
     conda:
         ENV
@@ -24,6 +23,7 @@ rule pulses:
         runtime=ANALYSIS_JOB["runtime"],
     params:
         estimators=config["analysis"]["estimators"],
+        software=SOFTWARE,
     script:
         "../scripts/pulses.py"
 
@@ -37,11 +37,12 @@ rule delays:
         f"{TABLES}/delays.csv",
     log:
         f"{LOGS}/tables/delays.log",
-    benchmark:
-        f"{BENCH}/tables/delays.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
+    params:
+        software=SOFTWARE,
     script:
         "../scripts/delays.py"
 
@@ -58,11 +59,12 @@ rule delay_fits:
         ),
     log:
         f"{LOGS}/tables/delay_fits.log",
-    benchmark:
-        f"{BENCH}/tables/delay_fits.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
+    params:
+        software=SOFTWARE,
     script:
         "../scripts/delay_fits.py"
 
@@ -77,8 +79,7 @@ rule ssw:
         f"{TABLES}/ssw.csv",
     log:
         f"{LOGS}/tables/ssw.log",
-    benchmark:
-        f"{BENCH}/tables/ssw.tsv"
+    cache: REUSE
     priority: 2
     conda:
         ENV
@@ -87,6 +88,7 @@ rule ssw:
         runtime=ANALYSIS_JOB["runtime"],
     params:
         estimator=config["analysis"]["main_estimator"],
+        software=SOFTWARE,
     script:
         "../scripts/ssw.py"
 
@@ -103,11 +105,12 @@ rule ssw_fits:
         ),
     log:
         f"{LOGS}/tables/ssw_fits.log",
-    benchmark:
-        f"{BENCH}/tables/ssw_fits.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
+    params:
+        software=SOFTWARE,
     script:
         "../scripts/ssw_fits.py"
 
@@ -122,8 +125,7 @@ rule c_sensitivity:
         f"{TABLES}/c_sensitivity.csv",
     log:
         f"{LOGS}/tables/c_sensitivity.log",
-    benchmark:
-        f"{BENCH}/tables/c_sensitivity.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
@@ -131,6 +133,7 @@ rule c_sensitivity:
         plan=PLAN.c_sensitivity,
         # Every input of each simulation of the study (RunPlan.c_sensitivity_jobs).
         jobs=PLAN.c_sensitivity_jobs(),
+        software=SOFTWARE,
     script:
         "../scripts/c_sensitivity.py"
 
@@ -144,11 +147,9 @@ rule ssw_track:
         code("ssw_track"),
     output:
         track=f"{OUT}/simulation/{{model}}_N{{N}}_ssw_track.csv",
-        field=f"{OUT}/simulation/{{model}}_N{{N}}_field.csv",
     log:
         f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
-    benchmark:
-        f"{BENCH}/simulate/{{model}}_N{{N}}_ssw_track.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
@@ -160,10 +161,42 @@ rule ssw_track:
         runtime=simulate_runtime,
     params:
         job=simulate_job,
-        representative_force_N=config["figures"]["representative_force_N"],
-        representative_index=config["figures"]["representative_index"],
+        software=SOFTWARE,
+        N=restate("N"),
+        model=restate("model"),
     script:
         "../scripts/ssw_track.py"
+
+
+# The collision the space-time figure shows, on each chain it shows (PLAN.field_chains):
+# one job integrates that one shot again, every contact recorded, at ssw_track's step
+# (the same numbers bit for bit): a figure key picking another collision costs
+# milliseconds of integration, not the tracks.
+rule ssw_fields:
+    input:
+        tracks=[
+            f"{OUT}/simulation/{PLAN.spacetime_model}_N{n}_ssw_track.csv"
+            for n in PLAN.field_chains
+        ],
+        lib=code("ssw_fields"),
+    output:
+        **{
+            f"N{n}": f"{OUT}/simulation/{PLAN.spacetime_model}_N{n}_field.csv"
+            for n in PLAN.field_chains
+        },
+    log:
+        f"{LOGS}/simulate/ssw_fields.log",
+    cache: REUSE
+    priority: 1
+    conda:
+        ENV
+    params:
+        jobs=[PLAN.simulate_job(PLAN.spacetime_model, n) for n in PLAN.field_chains],
+        representative_force_N=config["figures"]["representative_force_N"],
+        representative_index=config["figures"]["representative_index"],
+        software=SOFTWARE,
+    script:
+        "../scripts/ssw_fields.py"
 
 
 rule ssw_speed:
@@ -179,13 +212,13 @@ rule ssw_speed:
         speed=f"{TABLES}/ssw_speed.csv",
     log:
         f"{LOGS}/tables/ssw_speed.log",
-    benchmark:
-        f"{BENCH}/tables/ssw_speed.tsv"
+    cache: REUSE
     priority: 1
     conda:
         ENV
     params:
         material=config["material"],
         radius_m=config["radius_m"],
+        software=SOFTWARE,
     script:
         "../scripts/ssw_speed.py"

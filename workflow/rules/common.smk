@@ -4,7 +4,10 @@
 # (chain.pipeline.plan.RunPlan); each study's helpers sit in its own rule file.
 
 import importlib.util
+import os
 from pathlib import Path
+
+from snakemake.exceptions import WorkflowError
 
 from chain.pipeline.config import check_config
 from chain.pipeline.datasets import (
@@ -14,9 +17,43 @@ from chain.pipeline.datasets import (
 )
 from chain.pipeline.deps import script_sources
 from chain.pipeline.plan import RunPlan
+from chain.pipeline.reuse import (
+    CACHE_VARIABLE,
+    cache_folder,
+    software_versions,
+    unhashed_wildcards,
+)
 
 check_config(config)
 PLAN = RunPlan(config)
+
+# ---- reuse across runs (issue 33; chain.pipeline.reuse) ---------------------------
+# Each deterministic step is marked `cache` (= REUSE); the workflow profile
+# (profiles/default, profiles/slurm) turns Snakemake's between-workflow cache on, and
+# this folder is its store: a job whose script, params, code and upstream jobs match one
+# any run of this checkout made takes that run's files (symlinks into results/.cache)
+# instead of running. `reuse: false` computes everything anew (and stores nothing).
+REUSE = config["reuse"]
+os.environ[CACHE_VARIABLE] = str(cache_folder(os.environ, Path.cwd()))
+Path(os.environ[CACHE_VARIABLE]).mkdir(parents=True, exist_ok=True)
+# Versions the provenance hash does not see; a `software` param of each cached rule.
+SOFTWARE = software_versions()
+
+
+def restate(name):
+    """A param holding wildcard `name`: the cache's hash leaves wildcards out."""
+    return lambda wildcards: wildcards[name]
+
+
+def check_reused_rules(rules):
+    """Refuse, at parse time, a cached rule that would share results between jobs."""
+    problems = unhashed_wildcards(
+        (rule.name, rule.wildcard_names, rule.params.keys())
+        for rule in rules
+        if rule.cache
+    )
+    if problems:
+        raise WorkflowError("\n".join(problems))
 
 
 wildcard_constraints:

@@ -28,8 +28,7 @@ rule virtual_experiment:
         directory(f"{OUT}/experiment/raw/N{{N}}"),
     log:
         f"{LOGS}/experiment/virtual_N{{N}}.log",
-    benchmark:
-        f"{BENCH}/experiment/virtual_N{{N}}.tsv"
+    cache: REUSE
     priority: 3
     conda:
         ENV
@@ -42,6 +41,8 @@ rule virtual_experiment:
     params:
         settings=virtual_settings,
         dataset=PLAN.virtual_name,
+        software=SOFTWARE,
+        N=restate("N"),
     script:
         "../scripts/virtual_experiment.py"
 
@@ -49,14 +50,15 @@ rule virtual_experiment:
 # One job loads every dataset: a job costs ~2.5 s of Python start-up, a load ~1 s.
 rule experiment_traces:
     input:
-        datasets=experiment_dataset_files(),
+        virtual=virtual_dataset_folders(),
+        measured=measured_dataset_files(),
         lib=code("experiment_traces"),
     output:
-        experiment_trace_files(),
+        # Named, in order: a cached rule's outputs need names (one stored file each).
+        **{f"dataset{i}": path for i, path in enumerate(experiment_trace_files())},
     log:
         f"{LOGS}/experiment/traces.log",
-    benchmark:
-        f"{BENCH}/experiment/traces.tsv"
+    cache: REUSE
     priority: 3
     conda:
         ENV
@@ -64,6 +66,7 @@ rule experiment_traces:
         datasets=experiment_datasets(),
         bad_channels=BAD_CHANNELS,
         cache=str(DATASET_CHECK_CACHE),
+        software=SOFTWARE,
     script:
         "../scripts/experiment_traces.py"
 
@@ -72,7 +75,8 @@ rule selection:
     input:
         pulses=f"{TABLES}/pulses.csv",
         traces=experiment_trace_files,
-        datasets=experiment_dataset_files(),
+        virtual=virtual_dataset_folders(),
+        measured=measured_dataset_files(),
         lib=code("selection"),
     output:
         report(
@@ -82,8 +86,7 @@ rule selection:
         ),
     log:
         f"{LOGS}/experiment/selection.log",
-    benchmark:
-        f"{BENCH}/experiment/selection.tsv"
+    cache: REUSE
     priority: 2
     conda:
         ENV
@@ -93,5 +96,6 @@ rule selection:
         datasets=experiment_datasets(),
         bad_channels=BAD_CHANNELS,
         cache=str(DATASET_CHECK_CACHE),
+        software=SOFTWARE,
     script:
         "../scripts/selection.py"

@@ -8,25 +8,30 @@ def raw_dataset(n):
 
 
 def experiment_datasets():
-    """Each experiment dataset: its folder, series name, N and trace file."""
+    """Each experiment dataset: series name, N and folder; None for the virtual
+    experiment's, which the rules take as their `virtual` input, in order (a path
+    holding the run name in a param would make every run's result its own)."""
     return [
-        {
-            "folder": raw_dataset(part.n_beads) if part.folder is None else part.folder,
-            "name": part.name,
-            "N": part.n_beads,
-            "traces": trace_file("experiment", part.name, part.n_beads),
-        }
+        {"folder": part.folder, "name": part.name, "N": part.n_beads}
         for part in PLAN.experiment
     ]
 
 
-def experiment_dataset_files():
-    """What loading the datasets depends on: the virtual experiment's folders, or the
-    measured datasets' metadata.yaml and shot files (editing one reloads them)."""
+def virtual_dataset_folders():
+    """The virtual experiment's dataset folders (experiment/raw/N<N>), in order."""
+    return [
+        raw_dataset(part.n_beads) for part in PLAN.experiment if part.folder is None
+    ]
+
+
+def measured_dataset_files():
+    """What loading the measured datasets depends on: each metadata.yaml and shot
+    file (editing one reloads them)."""
     return [
         path
         for part in PLAN.experiment
-        for path in ([raw_dataset(part.n_beads)] if part.folder is None else part.files)
+        if part.folder is not None
+        for path in part.files
     ]
 
 

@@ -10,8 +10,7 @@ rule fig1_setup:
         **figure_outputs("fig1_setup"),
     log:
         f"{LOGS}/figures/fig1_setup.log",
-    benchmark:
-        f"{BENCH}/figures/fig1_setup.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
@@ -19,6 +18,7 @@ rule fig1_setup:
         radius_m=config["radius_m"],
         material=config["material"],
         striker_radius_m=config["setup"]["striker_radius_m"],
+        software=SOFTWARE,
     script:
         "../scripts/fig1_setup.py"
 
@@ -34,8 +34,7 @@ rule fig2_experiment_traces:
         **figure_outputs("fig2_experiment_traces"),
     log:
         f"{LOGS}/figures/fig2_experiment_traces.log",
-    benchmark:
-        f"{BENCH}/figures/fig2_experiment_traces.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
@@ -43,6 +42,7 @@ rule fig2_experiment_traces:
         or config["figures"]["representative_force_N"],
         estimator=config["analysis"]["main_estimator"],
         label=experiment_label,
+        software=SOFTWARE,
     script:
         "../scripts/fig2_experiment_traces.py"
 
@@ -60,8 +60,7 @@ rule fig3_simulation_traces:
         **figure_outputs("fig3_simulation_traces"),
     log:
         f"{LOGS}/figures/fig3_simulation_traces.log",
-    benchmark:
-        f"{BENCH}/figures/fig3_simulation_traces.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
@@ -70,6 +69,7 @@ rule fig3_simulation_traces:
         representative_index=config["figures"]["representative_index"],
         estimator=config["analysis"]["main_estimator"],
         label="simulation",
+        software=SOFTWARE,
     script:
         "../scripts/fig3_simulation_traces.py"
 
@@ -83,8 +83,7 @@ rule fig4_delay_vs_force:
         **figure_outputs("fig4_delay_vs_force"),
     log:
         f"{LOGS}/figures/fig4_delay_vs_force.log",
-    benchmark:
-        f"{BENCH}/figures/fig4_delay_vs_force.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
@@ -92,6 +91,7 @@ rule fig4_delay_vs_force:
         radius_m=config["radius_m"],
         estimator=config["analysis"]["main_estimator"],
         experiment_label=experiment_label,
+        software=SOFTWARE,
     script:
         "../scripts/fig4_delay_vs_force.py"
 
@@ -107,13 +107,13 @@ rule fig5_ssw_vs_force:
         **figure_outputs("fig5_ssw_vs_force"),
     log:
         f"{LOGS}/figures/fig5_ssw_vs_force.log",
-    benchmark:
-        f"{BENCH}/figures/fig5_ssw_vs_force.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
         experiment_label=experiment_label,
         sensors={n: list(s) for n, s in PLAN.chains.items()},
+        software=SOFTWARE,
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -126,12 +126,12 @@ rule fig_parity_ssw_vs_N:
         **figure_outputs("fig_parity_ssw_vs_N"),
     log:
         f"{LOGS}/figures/fig_parity_ssw_vs_N.log",
-    benchmark:
-        f"{BENCH}/figures/fig_parity_ssw_vs_N.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
         experiment_label=experiment_label,
+        software=SOFTWARE,
     script:
         "../scripts/fig_parity_ssw_vs_N.py"
 
@@ -156,14 +156,14 @@ rule ssw_spacetime:
         **figure_outputs("ssw_spacetime"),
     log:
         f"{LOGS}/figures/ssw_spacetime.log",
-    benchmark:
-        f"{BENCH}/figures/ssw_spacetime.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
         model=SPACETIME_MODEL,
         chains=list(PLAN.traces_n),
         long_chains=list(PLAN.long_chains),
+        software=SOFTWARE,
     script:
         "../scripts/fig_ssw_spacetime.py"
 
@@ -176,9 +176,10 @@ rule fig_c_sensitivity:
         **figure_outputs("fig_c_sensitivity"),
     log:
         f"{LOGS}/figures/fig_c_sensitivity.log",
-    benchmark:
-        f"{BENCH}/figures/fig_c_sensitivity.tsv"
+    cache: REUSE
     conda:
         ENV
+    params:
+        software=SOFTWARE,
     script:
         "../scripts/fig_c_sensitivity.py"

@@ -25,13 +25,13 @@ rule lammps_check:
         f"{TABLES}/lammps_check.csv",
     log:
         f"{LOGS}/tables/lammps_check.log",
-    benchmark:
-        f"{BENCH}/tables/lammps_check.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
         config=MECHANISM_CONFIG,
         estimator=config["analysis"]["main_estimator"],
+        software=SOFTWARE,
     script:
         "../scripts/lammps_check.py"
 
@@ -46,14 +46,16 @@ rule lammps_setting:
         ssw_fits=f"{OUT}/lammps/{{setting}}_N{{N}}_ssw_fits.csv",
     log:
         f"{LOGS}/lammps/{{setting}}_N{{N}}.log",
-    benchmark:
-        f"{BENCH}/lammps/{{setting}}_N{{N}}.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
         config=MECHANISM_CONFIG,
         sensors=lambda wildcards: list(PLAN.chains[int(wildcards.N)]),
         estimator=config["analysis"]["main_estimator"],
+        software=SOFTWARE,
+        N=restate("N"),
+        setting=restate("setting"),
     script:
         "../scripts/lammps_setting.py"
 
@@ -81,10 +83,9 @@ rule ssw_mechanisms:
         f"{TABLES}/ssw_mechanisms{{which}}.csv",
     log:
         f"{LOGS}/tables/ssw_mechanisms{{which}}.log",
-    benchmark:
-        f"{BENCH}/tables/ssw_mechanisms{{which}}.tsv"
     wildcard_constraints:
         which="|_all",
+    cache: REUSE
     conda:
         ENV
     params:
@@ -98,6 +99,8 @@ rule ssw_mechanisms:
         lammps_reference=PLAN.frictionless,
         candidates=lambda wildcards: candidates_of(wildcards.which),
         candidate_reference=CANDIDATE_REFERENCE,
+        software=SOFTWARE,
+        which=restate("which"),
     script:
         "../scripts/ssw_mechanisms.py"
 
@@ -110,9 +113,10 @@ rule fig_ssw_mechanisms:
         **figure_outputs("fig_ssw_mechanisms"),
     log:
         f"{LOGS}/figures/fig_ssw_mechanisms.log",
-    benchmark:
-        f"{BENCH}/figures/fig_ssw_mechanisms.tsv"
+    cache: REUSE
     conda:
         ENV
+    params:
+        software=SOFTWARE,
     script:
         "../scripts/fig_ssw_mechanisms.py"

@@ -14,8 +14,7 @@ rule simulate:
         runs=f"{OUT}/simulation/{{model}}_N{{N}}_runs.csv",
     log:
         f"{LOGS}/simulate/{{model}}_N{{N}}.log",
-    benchmark:
-        f"{BENCH}/simulate/{{model}}_N{{N}}.tsv"
+    cache: REUSE
     # First (3-4, see above), with the virtual experiment (3); long side jobs next (1).
     priority: lambda wildcards: 4 if int(wildcards.N) == next(iter(PLAN.chains)) else 3
     conda:
@@ -27,5 +26,8 @@ rule simulate:
     params:
         # Every input of the job (RunPlan.simulate_job): a changed one reruns it.
         job=simulate_job,
+        software=SOFTWARE,
+        N=restate("N"),
+        model=restate("model"),
     script:
         "../scripts/simulate.py"

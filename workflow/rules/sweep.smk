@@ -17,13 +17,13 @@ rule sweep_table:
         ),
     log:
         f"{LOGS}/tables/sweep.log",
-    benchmark:
-        f"{BENCH}/tables/sweep.tsv"
+    cache: REUSE
     conda:
         ENV
     params:
         eta_s=PLAN.models,
         estimator=config["analysis"]["main_estimator"],
+        software=SOFTWARE,
     script:
         "../scripts/sweep_table.py"
 
@@ -36,9 +36,10 @@ rule fig_c_vs_N:
         **figure_outputs("fig_c_vs_N"),
     log:
         f"{LOGS}/figures/fig_c_vs_N.log",
-    benchmark:
-        f"{BENCH}/figures/fig_c_vs_N.tsv"
+    cache: REUSE
     conda:
         ENV
+    params:
+        software=SOFTWARE,
     script:
         "../scripts/fig_c_vs_N.py"

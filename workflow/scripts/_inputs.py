@@ -9,3 +9,10 @@ def selection(snakemake):
     if not paths:
         return None
     return pd.concat([pd.read_csv(path) for path in paths], ignore_index=True)
+
+
+def dataset_folders(snakemake):
+    """Each experiment dataset's folder, in the order of ``params.datasets``: a measured
+    one's from its entry, the virtual experiment's from the ``virtual`` input."""
+    virtual = iter(snakemake.input.virtual)
+    return [dataset["folder"] or next(virtual) for dataset in snakemake.params.datasets]

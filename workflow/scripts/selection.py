@@ -1,6 +1,7 @@
 """The paper's acceptance protocol on the experiment shots (chain.analysis.selection)."""
 
 import pandas as pd
+from _inputs import dataset_folders
 from _logging import start
 
 from chain.analysis.selection import select_shots
@@ -22,8 +23,8 @@ table = select_shots(pulses, p.tolerance, estimator=p.estimator, shots=shots)
 if p.bad_channels == "skip":
     # Shots left out of the traces for a dead or saturated channel: rejected, with why.
     skipped = [
-        skipped_shot_rows(check_dataset(d["folder"], cache_dir=p.cache), d["name"])
-        for d in p.datasets
+        skipped_shot_rows(check_dataset(folder, cache_dir=p.cache), d["name"])
+        for d, folder in zip(p.datasets, dataset_folders(snakemake))
     ]
     table = pd.concat([table, *skipped], ignore_index=True)
     table = table.sort_values(["source", "model", "N", "shot"], kind="stable")

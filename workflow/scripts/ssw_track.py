@@ -1,17 +1,16 @@
 """Re-simulate one chain's collisions with every contact recorded and track the SSW
-(chain.analysis.ssw_track); write the track and the field of the shot Fig. ssw_spacetime shows."""
+(chain.analysis.ssw_track). The field Fig. ssw_spacetime shows: ssw_fields.py."""
 
 from _logging import start
 
-from chain.analysis.ssw_track import field_table, representative_shot, ssw_track_table
+from chain.analysis.ssw_track import ssw_track_table
 from chain.apparatus.shots import shot_time_step
 from chain.atomic import write_csv_atomic
 from chain.physics.simulation import simulate
 from chain.pipeline.jobs import chain_of
 
 log = start(snakemake)
-p = snakemake.params
-job = p.job
+job = snakemake.params.job
 model = chain_of(job)
 # The collision shots of the simulate rule (same step, duration and sampling), with
 # every contact force kept instead of two sensor readings.
@@ -30,9 +29,5 @@ result = simulate(
 )
 track = ssw_track_table(result.time, result.contact_force, source="simulation", model=job["model"])
 log.info("%d of %d contacts separated", track["separated"].sum(), len(track))
-shot = representative_shot(track, p.representative_force_N, p.representative_index)
 write_csv_atomic(track, snakemake.output.track)
-write_csv_atomic(
-    field_table(result.time, result.contact_force[shot], shot=shot), snakemake.output.field
-)
-log.info("field of shot %d written", shot)
+log.info("done")

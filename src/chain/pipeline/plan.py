@@ -147,6 +147,12 @@ class RunPlan:
         """Chains whose SSW is tracked contact by contact: the chains, then the long ones."""
         return (*self.chains, *self.long_chains)
 
+    @property
+    def field_chains(self) -> tuple[int, ...]:
+        """Chains whose field the space-time figure shows: Fig. 3's chains, then the
+        long ones."""
+        return (*self.traces_n, *self.long_chains)
+
     def sensors(self, n_beads: int) -> tuple[int, ...]:
         """Sensor beads of the chain of N beads, S1 first (none for a long chain)."""
         return self.chains.get(int(n_beads), ())

@@ -1,0 +1,38 @@
+"""Re-simulate the collision Fig. ssw_spacetime shows on each of its chains, every
+contact recorded, and write its field (chain.analysis.ssw_track.field_table).
+
+Only the shown shot is integrated again, at the time step of the whole batch of
+ssw_track, which makes it the same numbers bit for bit: a figure key (which collision
+is shown) recomputes milliseconds of integration, not the tracks."""
+
+import pandas as pd
+from _logging import start
+
+from chain.analysis.ssw_track import field_table, representative_shot
+from chain.apparatus.shots import shot_time_step
+from chain.atomic import write_csv_atomic
+from chain.physics.simulation import simulate
+from chain.pipeline.jobs import chain_of
+
+log = start(snakemake)
+p = snakemake.params
+for job, track_file, field_file in zip(p.jobs, snakemake.input.tracks, snakemake.output):
+    model = chain_of(job)
+    speeds = job["speeds_m_s"]
+    shot = representative_shot(
+        pd.read_csv(track_file), p.representative_force_N, p.representative_index
+    )
+    result = simulate(
+        model,
+        [speeds[shot]],
+        [speeds[shot]],
+        duration=job["duration_s"],
+        dt=shot_time_step(model, speeds, job["time_step_s"], job["record_interval_s"]),
+        record_interval=job["record_interval_s"],
+        max_energy_drift=job["max_energy_drift"],
+        contacts="all",
+        beads=(),
+    )
+    write_csv_atomic(field_table(result.time, result.contact_force[0], shot=shot), field_file)
+    log.info("%s N = %d: field of shot %d written", job["model"], job["N"], shot)
+log.info("done")
