@@ -42,14 +42,16 @@ from chain.studies.mechanism_settings import (
 )
 
 #: The contract tables of every run (tables/<name>.csv), in order.
-TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed c_sensitivity".split())
+TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed".split())
 
 #: The figures of every run (figures/<name>.pdf and .png), in order; Fig. 2 follows
 #: Fig. 1 when the run has an experiment, the optional figures come last.
 FIGURES = tuple(
-    "fig1_setup fig3_simulation_traces fig4_delay_vs_force fig5_ssw_vs_force ssw_spacetime "
-    "fig_c_sensitivity".split()
+    "fig1_setup fig3_simulation_traces fig4_delay_vs_force fig5_ssw_vs_force ssw_spacetime".split()
 )
+
+#: The studies a config's ``studies`` switches on or off, in config order.
+STUDIES = ("ablation", "c_sensitivity", "mechanisms")
 
 
 def launch_speeds(launch: Mapping) -> tuple[float, ...]:
@@ -293,18 +295,24 @@ class RunPlan:
                 jobs.append(self.simulate_job(name, n, eta_s=eta, sensors=beads))
         return jobs
 
+    def study(self, name: str) -> bool:
+        """Whether the run makes the study ``name`` (config ``studies.<name>``; one of
+        :data:`STUDIES`)."""
+        return bool(self.config["studies"][name])
+
     @property
-    def mechanism_study(self) -> bool:
-        """Whether the mechanism study runs (config ``mechanism_study``)."""
-        return bool(self.config["mechanism_study"])
+    def studies_not_run(self) -> list[str]:
+        """The studies the config switches off, in :data:`STUDIES` order."""
+        return [name for name in STUDIES if not self.study(name)]
 
     def ablation_names(self, full: bool) -> list[str]:
         """Variants of tables/ablation_exponent.csv (the default run's: those with
         default_run that name no mechanism, not the candidates' reference; only with
-        the virtual experiment), or with ``full`` of ablation_exponent_all.csv (all)."""
+        the virtual experiment and ``studies.ablation``), or with ``full`` of
+        ablation_exponent_all.csv (all, whether the study is on or not: asked for)."""
         if full:
             return list(self.ablation)
-        if not self.virtual_run:
+        if not (self.virtual_run and self.study("ablation")):
             return []
         return [
             name
@@ -326,8 +334,8 @@ class RunPlan:
 
     @cached_property
     def lammps(self) -> bool:
-        """Whether the LAMMPS rules run: the mechanism study is on and LAMMPS imports."""
-        return self.mechanism_study and lammps_available()
+        """Whether the LAMMPS rules run: ``studies.mechanisms`` is on and LAMMPS imports."""
+        return self.study("mechanisms") and lammps_available()
 
     def sweep(self, full: bool) -> dict[str, tuple[float, float]]:
         """Setting name -> (mu_t, mu_b) of the LAMMPS friction sweep (default run's or all)."""
@@ -345,8 +353,8 @@ class RunPlan:
     def candidates(self, full: bool) -> dict[str, tuple[str, str]]:
         """Variant -> (mechanism, setting) of the mechanism study's candidates (the
         virtual experiment's ablation variants with a mechanism); empty unless the
-        experiment is virtual and the study on."""
-        if not (self.virtual_run and self.mechanism_study):
+        experiment is virtual and ``studies.mechanisms`` on."""
+        if not (self.virtual_run and self.study("mechanisms")):
             return {}
         return candidate_variants(list(self.ablation.values()), full)
 
@@ -363,6 +371,8 @@ class RunPlan:
         names = list(FIGURES)
         if self.experiment:
             names.insert(1, "fig2_experiment_traces")
+        if self.study("c_sensitivity"):
+            names.append("fig_c_sensitivity")
         if figures["parity_ssw_vs_N"]:
             names.append("fig_parity_ssw_vs_N")
         if figures["sweep_vs_N"]:
@@ -376,9 +386,10 @@ class RunPlan:
 
         Parameters
         ----------
-        name : {"ablation_exponent", "sweep", "lammps_check", "ssw_mechanisms"}
+        name : {"c_sensitivity", "ablation_exponent", "sweep", "lammps_check", "ssw_mechanisms"}
         """
         made = {
+            "c_sensitivity": self.study("c_sensitivity"),
             "ablation_exponent": bool(self.ablation_names(full=False)),
             "sweep": bool(self.config["figures"]["sweep_vs_N"]),
             "lammps_check": self.lammps,
@@ -391,6 +402,7 @@ class RunPlan:
         out = self.out
         return (
             [f"{self.tables}/{table}.csv" for table in TABLES]
+            + self.optional_table("c_sensitivity")
             + self.optional_table("ablation_exponent")
             + [f"{self.figures}/{n}.{ext}" for n in self.figure_names() for ext in ("pdf", "png")]
             + [f"{out}/summary.json", f"{out}/summary.md", f"{out}/article.pdf"]
