@@ -12,6 +12,31 @@ def ablation_settings(wildcards):
     return PLAN.ablation_settings(wildcards.variant)
 
 
+def ablation_datasets(wildcards):
+    """Per replicate, the run's virtual-experiment datasets it reads instead of
+    simulating the same shots again, or [] (RunPlan.ablation_datasets)."""
+    return PLAN.ablation_datasets(wildcards.variant)
+
+
+def ablation_dataset_files(wildcards):
+    return sorted(
+        {folder for folders in ablation_datasets(wildcards) for folder in folders}
+    )
+
+
+# Variants with the settings and tolerance of one listed before them (e.g.
+# sensor_bead_off = point_readout): their outputs are that variant's, copied.
+ABLATION_TWINS = PLAN.ablation_twins
+
+
+def twin_outputs(wildcards):
+    twin = ABLATION_TWINS[wildcards.variant]
+    return {
+        "fits": f"{OUT}/ablation/{twin}_fits.csv",
+        "ssw_fits": f"{OUT}/ablation/{twin}_ssw_fits.csv",
+    }
+
+
 def ablation_tolerance(wildcards):
     return PLAN.ablation_tolerance(wildcards.variant)
 

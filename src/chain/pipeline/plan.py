@@ -18,6 +18,7 @@ is first asked).
 from __future__ import annotations
 
 import copy
+import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -270,6 +271,11 @@ class RunPlan:
         ``experiment.virtual`` under its own names, the seed the run's + N."""
         return virtual_experiment_settings(self.config, int(n_beads), self.chains[int(n_beads)])
 
+    def raw_dataset(self, n_beads: int) -> str:
+        """Folder of the virtual experiment's dataset of the chain of N beads (the
+        ``virtual_experiment`` job's output, in the measured-trace format)."""
+        return f"{self.out}/experiment/raw/N{int(n_beads)}"
+
     def virtual_experiment(self, n_beads: int) -> VirtualExperiment:
         """The virtual experiment of the chain of N beads (:meth:`virtual_settings`)."""
         return VirtualExperiment(**self.virtual_settings(n_beads))
@@ -331,6 +337,31 @@ class RunPlan:
     def ablation_tolerance(self, name: str) -> float | None:
         """Acceptance tolerance of a variant; None keeps every collision shot."""
         return variant_tolerance(self.config, self.ablation[name])
+
+    def ablation_datasets(self, name: str) -> list[list[str]]:
+        """Per replicate of a variant, the run's virtual-experiment datasets (one folder
+        per chain, :meth:`raw_dataset`) when that replicate's settings are the run's
+        virtual experiment's for every chain (its shots are those files, byte for
+        byte), else ``[]`` (the variant simulates its shots)."""
+        run = [self.virtual_settings(n) for n in self.chains] if self.virtual_run else None
+        return [
+            [self.raw_dataset(n) for n in self.chains] if chains == run else []
+            for chains in self.ablation_settings(name)
+        ]
+
+    @cached_property
+    def ablation_twins(self) -> dict[str, str]:
+        """Variant -> the first variant listed before it with the same settings (every
+        replicate) and tolerance, whose outputs are therefore its own (copied, not
+        computed again); only variants that have such a twin."""
+        first: dict[str, str] = {}
+        twins = {}
+        for name in self.ablation:
+            key = json.dumps([self.ablation_settings(name), self.ablation_tolerance(name)])
+            if key in first:
+                twins[name] = first[key]
+            first.setdefault(key, name)
+        return twins
 
     @cached_property
     def lammps(self) -> bool:
