@@ -211,3 +211,51 @@ def test_ablation_table_keeps_the_runs_seed_and_the_spread_over_seeds():
     assert row["series"] == "virtual experiment (model)"
     single = ablation_table({"x": fits[fits["replicate"] == 0]}, {})
     assert math.isnan(single.iloc[0]["exponent_seed_std"])
+
+
+def test_a_variant_reading_the_runs_experiment_gets_what_simulating_gives(tmp_path, monkeypatch):
+    """A replicate with the run's own settings reads the run's virtual experiment
+    (RunPlan.ablation_datasets) instead of simulating it: the same traces, pulses and
+    selection, to the bit, as simulating those shots again, noise and mismatch included."""
+    from chain.apparatus.virtual import run_virtual_experiment
+    from chain.studies import ablation
+    from chain.studies.ablation import run_variant_shots
+
+    chains = [
+        {**virtual_experiment_settings_of(n, sensors), "seed": 7 + n}
+        for n, sensors in ((16, (5, 12)), (17, (5, 13)))
+    ]
+    datasets = [tmp_path / f"N{c['n_beads']}" for c in chains]
+    for fields, folder in zip(chains, datasets, strict=True):
+        run_virtual_experiment(VirtualExperiment.from_dict(fields), folder, "virtual")
+    simulated = run_variant_shots(chains, 0.05, series="virtual")
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("simulated although the datasets were given")
+
+    monkeypatch.setattr(ablation, "run_virtual_experiment", no_simulation)
+    shared = run_variant_shots(chains, 0.05, series="virtual", datasets=datasets)
+    for mine, theirs in zip(simulated[0], shared[0], strict=True):
+        pd.testing.assert_frame_equal(mine, theirs, check_exact=True)
+    pd.testing.assert_frame_equal(simulated[1], shared[1], check_exact=True)
+    pd.testing.assert_frame_equal(simulated[2], shared[2], check_exact=True)
+    assert len(shared[1]) > 0 and shared[2]["kept"].any()
+
+
+def virtual_experiment_settings_of(n_beads: int, sensors) -> dict:
+    """A small virtual experiment with every imperfection on (fields, plain values)."""
+    settings = dataclasses.replace(
+        SMALL,
+        n_beads=n_beads,
+        sensor_beads=tuple(sensors),
+        impact_speeds_m_s=(1.0, 1.6),
+        collision_shots=2,
+        speed_mismatch=0.02,
+        timing_jitter_s=1e-5,
+        noise_N=0.1,
+        adc_bits=12,
+        sampling_interval_s=2e-6,
+        duration_s=1.5e-3,
+        time_step_s=2.5e-7,
+    )
+    return dataclasses.asdict(settings)

@@ -471,3 +471,21 @@ def test_the_why_not_of_the_simulated_c_quotes_the_mechanism_study():
     quoted = {row["claim"]: row["why"] for row in claims({**far, "ssw_mechanisms": study})}
     assert "mechanism study models both" in quoted[name]
     assert "N = 25: C 44.2 -> 45.1-49.8 µs N^(1/6)" in quoted[name]
+
+
+def test_studies_switched_off_are_said_not_run(tmp_path, figures):
+    """A run whose config switches studies off (summary ``studies_not_run``) says so
+    where each study's finding would be, naming the key; none of them is made up."""
+    summary = {**copy.deepcopy(SUMMARY), "studies_not_run": ["ablation", "c_sensitivity"]}
+    numbers = article_numbers(decided(summary), setup=None)
+    assert numbers["absent"] == {
+        "ablation": "not run in this run (config studies.ablation: false)",
+        "c_sensitivity": "not run in this run (config studies.c_sensitivity: false)",
+        "mechanisms": NOT_COMPUTED,
+    }
+    shown = {k: v for k, v in figures.items() if k != "fig_c_sensitivity"}
+    compile_article(SOURCE, numbers, list(shown.values()), tmp_path / "article.pdf")
+    text = pdf_text(tmp_path / "article.pdf")
+    for study in ("ablation", "c_sensitivity"):
+        assert f"notruninthisrun(configstudies.{study}:false)" in text, study
+    assert "Themechanismstudy:" + NOT_COMPUTED.replace(" ", "") in text

@@ -104,6 +104,9 @@ BAD_CONFIGS = [
     (("experiment", "bad_channels"), "ignore"),
     (("experiment", "source"), "lab"),
     (("launch", "v0_min_m_s"), "fast"),
+    (("studies", "ablation"), "yes"),
+    (("studies", "mechanisms"), 1),
+    (("studies", "c_sensitivity"), None),
 ]
 
 
@@ -115,6 +118,22 @@ def test_bad_config_is_stopped_naming_the_key(paper, tmp_path, monkeypatch, path
     message = stop_message(apply(paper, path, value), tmp_path)
     assert named(message, path), message
     assert not (tmp_path / "results").exists()
+
+
+@pytest.mark.parametrize("study", ["lammps", "mechanism_study"])
+def test_unknown_study_is_stopped_naming_it(paper, tmp_path, monkeypatch, study):
+    """A study the run does not know (a typo, the retired top-level key's name) stops
+    the run, naming the ``studies`` key and the unknown name."""
+    monkeypatch.chdir(tmp_path)
+    message = stop_message(apply(paper, ("studies", study), True), tmp_path)
+    assert f"'{study}' was unexpected" in message and named(message, ("studies",)), message
+    assert not (tmp_path / "results").exists()
+
+
+def test_the_retired_mechanism_study_key_is_stopped(paper, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    message = stop_message({**paper, "mechanism_study": False}, tmp_path)
+    assert "'mechanism_study' was unexpected" in message, message
 
 
 def test_every_non_finite_key_is_listed_at_once(paper):

@@ -114,13 +114,77 @@ def test_targets_follow_the_experiment_and_the_studies(paper, plan):
     assert "fig2_experiment_traces" in plan.figure_names()
     none = copy.deepcopy(paper)
     none["experiment"]["source"] = "none"
-    none["mechanism_study"] = False
+    none["studies"]["mechanisms"] = False
     bare = RunPlan(none)
     assert bare.experiment == () and bare.experiment_label == "experiment"
     assert "fig2_experiment_traces" not in bare.figure_names()
     assert bare.optional_table("ablation_exponent") == []
     assert bare.candidates(full=True) == {} and not bare.lammps
     assert not any("ssw_mechanisms" in path for path in bare.targets())
+
+
+def figure(name: str) -> list[str]:
+    return [f"figures/{name}.pdf", f"figures/{name}.png"]
+
+
+# Each study's own files (tables/<name>.csv, figures/<name>.pdf|png).
+STUDY_FILES = {
+    "ablation": ["tables/ablation_exponent.csv"],
+    "c_sensitivity": ["tables/c_sensitivity.csv", *figure("fig_c_sensitivity")],
+    "mechanisms": ["tables/ssw_mechanisms.csv", *figure("fig_ssw_mechanisms")],
+}
+
+
+@pytest.mark.parametrize("study", sorted(STUDY_FILES))
+def test_a_study_switched_off_leaves_exactly_its_files(paper, plan, study):
+    config = copy.deepcopy(paper)
+    config["studies"][study] = False
+    off = RunPlan(config)
+    own = {f"{plan.out}/{path}" for path in STUDY_FILES[study]}
+    assert own <= set(plan.targets())
+    if study == "mechanisms":
+        own |= {path for path in plan.targets() if "lammps_check" in path}
+        assert not off.lammps and off.candidates(full=False) == {}
+    assert set(off.targets()) == set(plan.targets()) - own
+    assert off.studies_not_run == [study] and plan.studies_not_run == []
+
+
+def test_the_paper_run_makes_every_study_and_the_schema_defaults_to_all(paper):
+    assert paper["studies"] == {"ablation": True, "c_sensitivity": True, "mechanisms": True}
+    bare = copy.deepcopy(yaml.safe_load((ROOT / "config.yaml").read_text()))
+    del bare["studies"]
+    assert checked(bare)["studies"] == paper["studies"]
+
+
+def test_variants_with_the_runs_settings_read_the_runs_virtual_experiment(plan):
+    raw = [plan.raw_dataset(n) for n in plan.chains]
+    assert raw == [f"{plan.out}/experiment/raw/N25", f"{plan.out}/experiment/raw/N26"]
+    # The reference of the candidates and a tolerance-only variant are the run's own
+    # shots; of as_configured's 8 seeds, the first is the run's.
+    assert plan.ablation_datasets("mechanism_reference") == [raw]
+    assert plan.ablation_datasets("no_selection") == [raw]
+    assert plan.ablation_datasets("as_configured") == [raw] + [[]] * 7
+    assert plan.ablation_tolerance("no_selection") is None
+    # Any change to the shots (one seed, one switch) simulates anew.
+    for name in ("no_reference_mismatch", "no_noise_adc", "kk_2us", "off_centre_5pct"):
+        assert plan.ablation_datasets(name) == [[]], name
+
+
+def test_only_a_virtual_run_shares_its_experiment(paper):
+    config = copy.deepcopy(paper)
+    config["experiment"]["source"] = "none"
+    assert RunPlan(config).ablation_datasets("mechanism_reference") == [[]]
+
+
+def test_identical_variants_are_twins_of_the_first(paper, plan):
+    assert plan.ablation_twins == {"sensor_bead_off": "point_readout"}
+    assert plan.ablation_settings("sensor_bead_off") == plan.ablation_settings("point_readout")
+    # Another tolerance makes another analysis: no longer a twin.
+    config = copy.deepcopy(paper)
+    for variant in config["ablation"]["variants"]:
+        if variant["name"] == "sensor_bead_off":
+            variant["set"]["tolerance"] = 0.1
+    assert RunPlan(config).ablation_twins == {}
 
 
 def test_the_plan_is_frozen_and_keeps_its_own_config(paper):

@@ -436,3 +436,13 @@ def test_markdown_has_no_raw_e_notation(summary):
 def test_e_notation_pattern_finds_numbers_not_hashes():
     found = E_NOTATION.findall("drift 5.5e-10, 1e+03 N, -2E5; commit 7ef8d179e4b2, T1e5")
     assert found == ["5.5e-10", "1e+03", "-2E5"]
+
+
+def test_studies_switched_off_are_said_not_run(summary):
+    """summary.md names each study the config switched off (``studies_not_run``), where
+    its rows would be; a run that made them all has no such line."""
+    assert "not run in this run" not in summary_markdown(summary)
+    text = summary_markdown({**summary, "studies_not_run": ["ablation", "mechanisms"]})
+    assert "| not run in this run (config studies.ablation: false) |" in text
+    assert "The mechanism study: not run in this run (config studies.mechanisms: false)." in text
+    assert "studies.c_sensitivity" not in text

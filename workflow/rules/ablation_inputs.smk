@@ -12,6 +12,34 @@ def ablation_settings(wildcards):
     return PLAN.ablation_settings(wildcards.variant)
 
 
+def ablation_reads_run(wildcards):
+    """Per replicate, whether it reads the run's virtual experiment (the `datasets`
+    input) instead of simulating the same shots again (RunPlan.ablation_datasets): a
+    flag, not the folders, whose path names the run (the result would be the run's own,
+    not reusable by another)."""
+    return [bool(folders) for folders in PLAN.ablation_datasets(wildcards.variant)]
+
+
+def ablation_dataset_files(wildcards):
+    """The run's virtual-experiment folders, one per chain in order, when a replicate
+    reads them; else none."""
+    replicates = PLAN.ablation_datasets(wildcards.variant)
+    return next((folders for folders in replicates if folders), [])
+
+
+# Variants with the settings and tolerance of one listed before them (e.g.
+# sensor_bead_off = point_readout): their outputs are that variant's, copied.
+ABLATION_TWINS = PLAN.ablation_twins
+
+
+def twin_outputs(wildcards):
+    twin = ABLATION_TWINS[wildcards.variant]
+    return {
+        "fits": f"{OUT}/ablation/{twin}_fits.csv",
+        "ssw_fits": f"{OUT}/ablation/{twin}_ssw_fits.csv",
+    }
+
+
 def ablation_tolerance(wildcards):
     return PLAN.ablation_tolerance(wildcards.variant)
 

@@ -50,7 +50,7 @@ def check_reused_rules(rules):
     problems = unhashed_wildcards(
         (rule.name, rule.wildcard_names, rule.params.keys())
         for rule in rules
-        if rule.cache
+        if getattr(rule.cache, "output", False)  # cached: REUSE true, --cache on
     )
     if problems:
         raise WorkflowError("\n".join(problems))

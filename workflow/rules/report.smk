@@ -8,7 +8,7 @@ rule summary:
     input:
         delay_fits=f"{TABLES}/delay_fits.csv",
         ssw_fits=f"{TABLES}/ssw_fits.csv",
-        c_sensitivity=f"{TABLES}/c_sensitivity.csv",
+        c_sensitivity=PLAN.optional_table("c_sensitivity"),
         ablation=PLAN.optional_table("ablation_exponent"),
         mechanisms=PLAN.optional_table("ssw_mechanisms"),
         lammps_check=PLAN.optional_table("lammps_check"),
@@ -37,6 +37,9 @@ rule summary:
         tolerance=config["experiment"]["tolerance"],
         friction_mechanism=FRICTION_MECHANISM,
         reference_mechanism=REFERENCE_MECHANISM,
+        # The studies the config's `studies` switches off (summary.md and the article
+        # say they were not run).
+        studies_not_run=PLAN.studies_not_run,
         # Commit, config hash, installed versions and how they compare with the lock.
         provenance=run_provenance(config, workflow.basedir),
     script:

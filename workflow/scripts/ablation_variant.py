@@ -1,5 +1,7 @@
 """One ablation variant of the virtual experiment (a model), all its replicates: delay
-fits (chain.studies.ablation) and SSW fits at S2 (chain.studies.mechanism_fits)."""
+fits (chain.studies.ablation) and SSW fits at S2 (chain.studies.mechanism_fits). A
+replicate with the run's own settings reads the run's virtual experiment (input
+datasets, where params reads_run says so) instead of simulating it again."""
 
 import pandas as pd
 from _logging import start
@@ -12,9 +14,12 @@ from chain.studies.mechanism_fits import variant_ssw_fits
 log = start(snakemake)
 p = snakemake.params
 tables, ssw_tables = [], []
-for replicate, chains in enumerate(p.settings):
+for replicate, (chains, reads_run) in enumerate(zip(p.settings, p.reads_run, strict=True)):
+    datasets = list(snakemake.input.datasets) if reads_run else []
+    if datasets:
+        log.info("replicate %d: the run's virtual experiment, %s", replicate, datasets)
     traces, pulses, selection = run_variant_shots(
-        chains, p.tolerance, p.estimators, series=p.series
+        chains, p.tolerance, p.estimators, series=p.series, datasets=datasets
     )
     fits = fit_pulses(pulses, selection)
     ssw_fits = variant_ssw_fits(traces, pulses, selection, p.estimators[0])

@@ -265,6 +265,6 @@ def check_run_bounds(config: Mapping) -> None:
     _check_sensors(config)
     _check_simulation(config)
     _check_long_chains(config)
-    if config.get("mechanism_study", True):
+    if config["studies"]["mechanisms"]:
         _check_lammps(config)
         _check_setting_names(config)

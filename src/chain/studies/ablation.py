@@ -17,6 +17,7 @@ This module reads no config and knows no Snakemake.
 
 from __future__ import annotations
 
+import os
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -67,13 +68,47 @@ def run_variant_shots(
     tolerance: float | None,
     estimators: Sequence[str] = ("fit_full",),
     series: str = VIRTUAL_SERIES,
+    datasets: Sequence[str | os.PathLike] | None = None,
 ) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
     """Run the virtual experiment on each chain and fit its pulses and select its shots
     as the pipeline does (parameters as :func:`run_variant`).
 
-    The shots go through the measured-data path (written in the measured-trace format
-    to a temporary folder and loaded back), pulses are fitted per chain and collisions
-    are selected with ``tolerance``.
+    The shots go through the measured-data path: written in the measured-trace format
+    to a temporary folder, then analysed by :func:`analyse_datasets`. With
+    ``datasets`` (one folder per chain, written by the virtual experiment with exactly
+    ``settings_per_chain`` and ``series``: the run's own, see
+    :meth:`chain.pipeline.plan.RunPlan.ablation_datasets`), those are analysed instead
+    of simulating the same shots again.
+
+    Returns
+    -------
+    As :func:`analyse_datasets`.
+    """
+    if datasets:
+        return analyse_datasets(datasets, tolerance, estimators, series)
+    with tempfile.TemporaryDirectory(prefix="ablation.") as folder:
+        written = []
+        for i, fields in enumerate(settings_per_chain):
+            written.append(Path(folder) / f"chain{i}")
+            run_virtual_experiment(VirtualExperiment.from_dict(fields), written[-1], series)
+        return analyse_datasets(written, tolerance, estimators, series)
+
+
+def analyse_datasets(
+    datasets: Sequence[str | os.PathLike],
+    tolerance: float | None,
+    estimators: Sequence[str] = ("fit_full",),
+    series: str = VIRTUAL_SERIES,
+) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
+    """Load a variant's shots, fit their pulses per chain and select the collisions
+    with ``tolerance``, as the pipeline does.
+
+    Parameters
+    ----------
+    datasets : sequence of path
+        Dataset folders in the measured-trace format, one per chain.
+    tolerance, estimators, series
+        As :func:`run_variant`.
 
     Returns
     -------
@@ -84,15 +119,10 @@ def run_variant_shots(
     selection : DataFrame or None
         The shot selection (None with ``tolerance`` None).
     """
-    pulses, traces = [], []
-    with tempfile.TemporaryDirectory(prefix="ablation.") as folder:
-        for i, fields in enumerate(settings_per_chain):
-            settings = VirtualExperiment.from_dict(fields)
-            dataset = Path(folder) / f"chain{i}"
-            run_virtual_experiment(settings, dataset, series)
-            traces.append(load_dataset(dataset, name=series))
-            pulses.append(pulse_table(traces[-1], estimators=tuple(estimators)))
-    table = pd.concat(pulses, ignore_index=True)
+    traces = [load_dataset(folder, name=series) for folder in datasets]
+    table = pd.concat(
+        [pulse_table(t, estimators=tuple(estimators)) for t in traces], ignore_index=True
+    )
     selection = None
     if tolerance is not None:
         selection = select_shots(table, tolerance, estimator=estimators[0])

@@ -46,6 +46,7 @@ from chain.report.text.article_ssw_tables import (
     separation_table,
 )
 from chain.report.text.article_tables import ablation_tables, c_spread_tables
+from chain.report.text.markdown_studies import not_run_text
 
 
 def fit_rows(summary: Mapping) -> list[dict]:
@@ -370,7 +371,9 @@ def article_numbers(
         ``fits`` and ``ssw_slopes`` (every row, printed), ``findings`` (SSW, ablation,
         C spread; None where not computed), ``figure_text`` (section, caption and
         paragraph per known figure, :mod:`chain.report.text.article_figures`),
-        ``provenance`` and ``not_computed`` (the phrase for those).
+        ``provenance``, ``not_computed`` (the phrase for those) and ``absent`` (per
+        study, "ablation", "c_sensitivity", "mechanisms": what the article says when its
+        finding is None: not run in this run, or not computed).
     """
     if "claims" not in (summary.get("verdicts") or {}):
         raise ValueError(
@@ -389,6 +392,10 @@ def article_numbers(
         "figure_text": {name: figure_text(name, summary) for name in CAPTIONS},
         "provenance": provenance_text(provenance),
         "not_computed": NOT_COMPUTED,
+        "absent": {
+            study: not_run_text(summary, study) or NOT_COMPUTED
+            for study in ("ablation", "c_sensitivity", "mechanisms")
+        },
     }
 
 

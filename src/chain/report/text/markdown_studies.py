@@ -1,7 +1,8 @@
 """``summary.md``'s rows and lines for the studies: the ablation of the virtual
 experiment, the spread of C over our choices (summary keys ``ablation`` and
-``c_spread``) and the mechanism study (``ssw_mechanisms``). Wording only: the verdicts
-are the summary's (:mod:`chain.report.numbers.spread`, :mod:`chain.report.numbers.mechanisms`).
+``c_spread``) and the mechanism study (``ssw_mechanisms``), or that the config switched
+a study off (``studies_not_run``). Wording only: the verdicts are the summary's
+(:mod:`chain.report.numbers.spread`, :mod:`chain.report.numbers.mechanisms`).
 """
 
 from __future__ import annotations
@@ -12,10 +13,24 @@ from chain.labels import VIRTUAL_LABEL
 from chain.report.printed import power_of_ten, without_e_notation
 
 
+def not_run_text(summary: Mapping, study: str) -> str | None:
+    """'not run in this run (config studies.<study>: false)' when the config switched
+    the study off (summary ``studies_not_run``), else None."""
+    if study not in (summary.get("studies_not_run") or ()):
+        return None
+    return f"not run in this run (config studies.{study}: false)"
+
+
 def spread_markdown_rows(summary: Mapping) -> list[tuple[str, str, str, str]]:
-    """``summary.md`` rows (quantity | paper | this run | note) for both keys, if present."""
+    """``summary.md`` rows (quantity | paper | this run | note) for both keys, if
+    present, or saying that the study was not run."""
     rows = []
     ablation = summary.get("ablation")
+    ablation_off = not_run_text(summary, "ablation")
+    if ablation_off:
+        rows.append(
+            (f"why the {VIRTUAL_LABEL}'s exponent differs (ablation)", "—", ablation_off, "")
+        )
     if ablation:
         rows.append(
             (
@@ -26,6 +41,9 @@ def spread_markdown_rows(summary: Mapping) -> list[tuple[str, str, str, str]]:
             )
         )
     spread = summary.get("c_spread")
+    spread_off = not_run_text(summary, "c_sensitivity")
+    if spread_off:
+        rows.append(("C of the simulation: spread over our choices", "—", spread_off, ""))
     if spread:
         rows.append(
             (
@@ -41,8 +59,17 @@ def spread_markdown_rows(summary: Mapping) -> list[tuple[str, str, str, str]]:
 
 
 def mechanism_markdown(summary: Mapping) -> list[str]:
-    """Lines of ``summary.md`` for the mechanism study (none without it)."""
+    """Lines of ``summary.md`` for the mechanism study (none without it; one line when
+    the config switched it off)."""
     study = summary.get("ssw_mechanisms")
+    off = not_run_text(summary, "mechanisms")
+    if off:
+        return [
+            "",
+            "## Why are the measured SSW larger? (models, not data)",
+            "",
+            f"The mechanism study: {off}.",
+        ]
     if not study:
         return []
     verdict = without_e_notation(study["verdict"], "unicode")
