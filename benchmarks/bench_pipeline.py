@@ -6,7 +6,8 @@ no results, no reuse store: a fresh clone), whose ``src`` the jobs import, and r
 order::
 
     paper       snakemake --cores 2                       numba's cache empty
-    forced      snakemake --cores 2 --forceall            warm (numba's cache, the store)
+    forced      snakemake --cores 2 --forceall --config reuse=False    warm numba cache,
+                                                          every job computed again
     brass       snakemake --cores 2 --configfile whatif/brass.yaml     after the paper run
     analysis    an overlay: run_name bench_analysis, analysis: {main_estimator: peak}
     figure      an overlay: run_name bench_figure, figures: {representative_force_N: 100}
@@ -19,8 +20,10 @@ README's test command runs once in the last copy (``--no-tests`` skips it)::
     python benchmarks/bench_pipeline.py                  # 3 rounds and the tests
     python benchmarks/bench_pipeline.py --repeat 1 --no-tests --keep /tmp/bench
 
-For the paper run it also prints, per rule, the jobs and their summed wall and CPU time
-(the ``benchmark:`` files): what bounds the figure.
+Each scenario's jobs are counted as run (the job started) or reused (its result taken
+from results/.cache, issue 33: its log stays empty). For the paper run it also prints,
+per rule, the jobs and their summed wall time from Snakemake's own start and finish
+lines (whole seconds): what bounds the figure.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from datetime import datetime
 from pathlib import Path
 
 import pandas as pd
@@ -45,17 +49,52 @@ ROOT = Path(__file__).resolve().parents[1]
 #: (name, snakemake arguments, overlay written into the copy or None, target s, stretch s)
 SCENARIOS = (
     ("paper", [], None, 45.0, 30.0),
-    ("forced", ["--forceall"], None, None, None),
+    ("forced", ["--forceall", "--config", "reuse=False"], None, None, None),
     ("brass", ["--configfile", "whatif/brass.yaml"], None, 40.0, None),
     ("analysis", ["--configfile", "bench_analysis.yaml"],
      "run_name: bench_analysis\nanalysis: {main_estimator: peak}\n", 15.0, None),
     ("figure", ["--configfile", "bench_figure.yaml"],
      "run_name: bench_figure\nfigures: {representative_force_N: 100}\n", 10.0, None),
 )  # fmt: skip
+#: Rules that integrate a chain (or run LAMMPS): an analysis what-if should run none.
+SIMULATIONS = (
+    "simulate", "virtual_experiment", "ssw_track", "ssw_fields", "lammps_setting",
+    "lammps_check", "ablation_variant", "c_sensitivity",
+)  # fmt: skip
 #: The test suite and .ci/run, s.
 TESTS_TARGET_S = 240.0
 
-_JOB_LINE = re.compile(r"^\s*(?:local)?rule (\w+):", re.MULTILINE)
+_STAMP = re.compile(r"^\[(\w{3} \w{3} +\d+ \d\d:\d\d:\d\d \d{4})\]$")
+_START = re.compile(r"^\s*(?:local)?rule (\w+):$")
+_FIELD = re.compile(r"^\s+(log|jobid): (.+)$")
+_FINISH = re.compile(r"^Finished jobid: (\d+) \(Rule: (\w+)\)$")
+
+
+def jobs_of(printed: str, work: Path) -> pd.DataFrame:
+    """One row per job Snakemake printed: rule, wall s (its start and finish lines, whole
+    seconds) and whether it ran (its log is not empty; a job reused from results/.cache
+    never starts and leaves an empty log)."""
+    jobs, stamp, current = {}, None, None
+    for line in printed.splitlines():
+        if match := _STAMP.match(line):
+            stamp = datetime.strptime(match.group(1), "%a %b %d %H:%M:%S %Y")
+        elif match := _START.match(line):
+            current = {"rule": match.group(1), "start": stamp, "log": None}
+        elif current is not None and (match := _FIELD.match(line)):
+            if match.group(1) == "log":
+                current["log"] = match.group(2).split(",")[0].strip()
+            else:
+                jobs[int(match.group(2))] = current
+        elif match := _FINISH.match(line):
+            job = jobs.get(int(match.group(1)))
+            if job is not None and job["start"] is not None:
+                job["wall_s"] = (stamp - job["start"]).total_seconds()
+    rows = []
+    for job in jobs.values():
+        log = work / job["log"] if job["log"] else None
+        ran = log is None or (log.is_file() and log.stat().st_size > 0)
+        rows.append({"rule": job["rule"], "wall_s": job.get("wall_s", 0.0), "ran": ran})
+    return pd.DataFrame(rows, columns=["rule", "wall_s", "ran"])
 
 
 def copy_checkout(work: Path) -> None:
@@ -92,7 +131,7 @@ def run(command: list[str], work: Path) -> tuple[float, str]:
 
 
 def one_round(work: Path, cores: int) -> dict:
-    """Every scenario once, in order, in a fresh copy: name -> (wall s, rules of the jobs)."""
+    """Every scenario once, in order, in a fresh copy: name -> (wall s, its jobs)."""
     copy_checkout(work)
     timings = {}
     for name, args, overlay, _, _ in SCENARIOS:
@@ -100,27 +139,19 @@ def one_round(work: Path, cores: int) -> dict:
             (work / f"bench_{name}.yaml").write_text(overlay)
         command = [sys.executable, "-m", "snakemake", "--cores", str(cores), *args]
         wall, printed = run(command, work)
-        timings[name] = (wall, _JOB_LINE.findall(printed))
-        print(f"  {name}: {wall:.1f} s, {len(timings[name][1])} jobs", flush=True)
+        jobs = jobs_of(printed, work)
+        timings[name] = (wall, jobs)
+        print(f"  {name}: {wall:.1f} s, {int(jobs['ran'].sum())} jobs run, "
+              f"{int((~jobs['ran']).sum())} reused", flush=True)  # fmt: skip
     return timings
 
 
-def per_rule(out: Path) -> pd.DataFrame:
-    """Per rule of a run: jobs and their summed wall and CPU time, s (benchmark files)."""
-    rows = []
-    for path in sorted((out / "benchmarks").rglob("*.tsv")):
-        table = pd.read_csv(path, sep="\t")
-        relative = path.relative_to(out / "benchmarks")
-        grouped = len(relative.parts) > 1 and relative.parts[0] not in ("tables", "figures")
-        rule = relative.parts[0] if grouped else relative.stem
-        wall, cpu = table["s"].iloc[-1], table["cpu_time"].iloc[-1]
-        rows.append({"rule": rule, "wall_s": wall, "cpu_s": cpu})
-    table = pd.DataFrame(rows)
-    if table.empty:
-        return table
+def per_rule(jobs: pd.DataFrame) -> pd.DataFrame:
+    """Per rule of a run's jobs that ran: how many and their summed wall time, s."""
+    ran = jobs[jobs["ran"]]
     return (
-        table.groupby("rule")
-        .agg(jobs=("rule", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"))
+        ran.groupby("rule")
+        .agg(jobs=("rule", "size"), wall_s=("wall_s", "sum"))
         .sort_values("wall_s", ascending=False)
     )
 
@@ -137,13 +168,15 @@ def verdict(conditions: Conditions, seconds: float, target, stretch) -> str:
 def summarise(rounds: list[dict], conditions: Conditions) -> None:
     print(f"\nbest of {len(rounds)} interleaved round(s), --cores as given:")
     for name, _, _, target, stretch in SCENARIOS:
-        wall, rules = min((r[name] for r in rounds), key=lambda pair: pair[0])
-        ran = sorted(set(rules))
+        wall, jobs = min((r[name] for r in rounds), key=lambda pair: pair[0])
+        ran = sorted(set(jobs.loc[jobs["ran"], "rule"]))
         shown = ", ".join(ran) if len(ran) <= 6 else f"{len(ran)} rules"
-        print(f"  {name:9s} {wall:6.1f} s  {len(rules):3d} jobs ({shown})  "
-              f"{verdict(conditions, wall, target, stretch)}")  # fmt: skip
-    simulated = [r for r in rounds[-1]["analysis"][1] if r in ("simulate", "virtual_experiment")]
-    print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none)")
+        print(f"  {name:9s} {wall:6.1f} s  {len(jobs):3d} jobs, {int(jobs['ran'].sum()):3d} run "
+              f"({shown})  {verdict(conditions, wall, target, stretch)}")  # fmt: skip
+    analysis = rounds[-1]["analysis"][1]
+    simulated = analysis[analysis["ran"] & analysis["rule"].isin(SIMULATIONS)]
+    print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none): "
+          f"{', '.join(sorted(set(simulated['rule']))) or '-'}")  # fmt: skip
 
 
 def main(argv=None) -> int:
@@ -164,7 +197,8 @@ def main(argv=None) -> int:
             rounds.append(one_round(work, args.cores))
             conditions.sample(f"after round {k + 1}")
         print("\nthe paper run of the last round, per rule (job wall and CPU, s):")
-        print(per_rule(work / "results" / "paper").to_string(float_format=lambda v: f"{v:.1f}"))
+        paper = rounds[-1]["paper"][1]
+        print(per_rule(paper).to_string(float_format=lambda v: f"{v:.0f}"))
         summarise(rounds, conditions)
         if not args.no_tests:
             conditions.sample("before the tests")
