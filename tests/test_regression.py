@@ -11,6 +11,7 @@ from chain.analysis.regression import (
     fit_fixed_exponent,
     fit_power_law,
     fit_proportional,
+    line_fit,
     ratio_with_error,
 )
 
@@ -137,3 +138,28 @@ def test_ratio_error_propagates_relative_errors_and_matches_sampling():
     assert np.std(draws) == pytest.approx(small["ratio_err"], rel=0.01)
     assert np.isnan(ratio_with_error(1.0, 0.1, 0.0, 0.1)["ratio"])
     assert np.isnan(ratio_with_error(1.0, 0.1, float("nan"), 0.1)["ratio_err"])
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_line_fit_is_scipy_linregress_to_the_bit(seed):
+    """line_fit replaces scipy.stats.linregress (a second of import per job) in the
+    log-log fits: the same four numbers, bit for bit, so that no table changes."""
+    from scipy.stats import linregress
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 40))
+    x = np.log(np.sort(rng.uniform(5.0, 2000.0, n)))
+    y = rng.normal(-1.0 / 6.0, 10.0 ** rng.uniform(-6, 0)) * x + rng.normal(0.0, 0.05, n)
+    if seed == 0:
+        y = 3.0 - x / 6.0  # exact line: r clipped to -1, zero stderr
+    if seed == 1:
+        y = np.full(n, 2.0)  # flat: r undefined
+    expected = linregress(x, y)
+    got = line_fit(x, y)
+    want = (expected.slope, expected.intercept, expected.stderr, expected.intercept_stderr)
+    np.testing.assert_array_equal(np.array(got), np.array(want))
+
+
+def test_line_fit_refuses_equal_x():
+    with pytest.raises(ValueError, match="identical"):
+        line_fit(np.ones(4), np.arange(4.0))

@@ -66,6 +66,18 @@ def test_round_trip_is_byte_stable(traces, tmp_path):
     assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
 
 
+@pytest.mark.parametrize("shots", [(0, 1), (1,)], ids=["both kinds", "reference only"])
+def test_unchecked_read_gives_the_checked_table(traces, tmp_path, shots):
+    """read_traces(check=False), for files write_traces wrote (a job's inputs), gives the
+    table the checked read gives: the same values and dtypes, to the bit. With reference
+    shots only, v0_right_m_s is written "0" on every row and must still come back float."""
+    path = tmp_path / "traces.csv"
+    write_traces(traces[traces["shot"].isin(shots)], path)
+    checked, unchecked = read_traces(path), read_traces(path, check=False)
+    pd.testing.assert_frame_equal(unchecked, checked, check_exact=True)
+    assert unchecked["v0_right_m_s"].dtype == float
+
+
 def test_simulated_traces_follow_the_format(tmp_path, tol):
     """A simulation's trace table validates, round-trips, and carries the felt force."""
     result = simulate(uniform_chain(26), [0.1, 0.2], [0.1, 0.2], duration=2e-4)

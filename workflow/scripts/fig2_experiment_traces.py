@@ -13,8 +13,9 @@ from chain.traces import read_traces
 
 log = start(snakemake)
 p = snakemake.params
+# Trace files of this run: write_traces checked them in the job that wrote them.
 fig = fig2_experiment_traces(
-    [read_traces(path) for path in snakemake.input.traces],
+    [read_traces(path, check=False) for path in snakemake.input.traces],
     pd.read_csv(snakemake.input.pulses),
     pd.read_csv(snakemake.input.ssw),
     representative_force_N=p.representative_force_N,

@@ -13,8 +13,9 @@ actually present, as ``scipy.optimize.curve_fit`` does by default
 the true errors and var(C) = 1 / sum(w g^2).
 
 The free power law is fitted in log-log (default): ln y = ln A + p ln x by
-:func:`scipy.stats.linregress` (weighted least squares by ``numpy.polyfit`` when sigma
-is given, with sigma_ln y = sigma / y), right for a relative scatter; or with
+:func:`line_fit` (the arithmetic of :func:`scipy.stats.linregress`, whose import costs
+a job a second; weighted least squares by ``numpy.polyfit`` when sigma is given, with
+sigma_ln y = sigma / y), right for a relative scatter; or with
 ``method="nonlinear"`` by ``scipy.optimize.curve_fit`` of A x^p on y itself, right for a
 constant absolute scatter. Both give the standard error of p from the residuals.
 
@@ -190,13 +191,7 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
     log_x, log_y = np.log(x), np.log(y)
     if method == "loglog":
         if sigma is None:
-            # Imported here: scipy.stats takes most of a second to import, and most jobs
-            # that import this module never fit a power law.
-            from scipy.stats import linregress
-
-            line = linregress(log_x, log_y)
-            exponent, exponent_error = line.slope, line.stderr
-            log_a, log_a_error = line.intercept, line.intercept_stderr
+            exponent, log_a, exponent_error, log_a_error = line_fit(log_x, log_y)
         else:
             # sigma of ln y is sigma / y; polyfit weights multiply the residuals.
             log_weight = y * np.sqrt(weight)
@@ -214,7 +209,7 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
             n,
             method,
         )
-    from scipy.optimize import curve_fit  # imported here: see the loglog branch
+    from scipy.optimize import curve_fit  # imported here: most fits need no scipy
 
     start = fit_power_law(x, y, method="loglog")
     params, covariance = curve_fit(
@@ -228,6 +223,39 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
     return PowerLawFit(
         float(params[0]), float(errors[0]), float(params[1]), float(errors[1]), n, method
     )
+
+
+def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
+    """Unweighted least-squares line y = slope x + intercept, and standard errors.
+
+    The arithmetic of :func:`scipy.stats.linregress` (scipy 1.17), operation for
+    operation, so that the numbers are the same to the last bit (a test compares them),
+    without importing scipy.stats, which costs a job about a second.
+
+    Parameters
+    ----------
+    x, y : array
+        At least 3 points, x not all equal; units of y per unit of x for the slope.
+
+    Returns
+    -------
+    tuple of float
+        slope, intercept, stderr of the slope, stderr of the intercept.
+    """
+    if np.amax(x) == np.amin(x):
+        raise ParameterError("cannot fit a line if all x values are identical")
+    x_mean = np.mean(x, None)
+    y_mean = np.mean(y, None)
+    ssxm, ssxym, _, ssym = np.cov(x, y, bias=1).flat
+    if ssxm == 0.0 or ssym == 0.0:
+        r = np.asarray(np.nan if ssxym == 0 else 0.0)[()]
+    else:
+        r = min(max(ssxym / np.sqrt(ssxm * ssym), -1.0), 1.0)
+    slope = ssxym / ssxm
+    intercept = y_mean - slope * x_mean
+    slope_stderr = np.sqrt((1 - r**2) * ssym / ssxm / (len(x) - 2))
+    intercept_stderr = slope_stderr * np.sqrt(ssxm + x_mean**2)
+    return slope, intercept, slope_stderr, intercept_stderr
 
 
 def _points(x, y, sigma):
