@@ -58,7 +58,7 @@ rule experiment_traces:
         **{f"dataset{i}": path for i, path in enumerate(experiment_trace_files())},
     log:
         f"{LOGS}/experiment/traces.log",
-    cache: REUSE
+    cache: REUSE and bool(EXPERIMENT_PARTS)  # no experiment: a rule without outputs
     priority: 3
     conda:
         ENV
