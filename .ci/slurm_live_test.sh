@@ -409,8 +409,11 @@ say "${#IDS[@]} jobs submitted with sbatch (ids ${IDS[0]}..${IDS[-1]}): $complet
     "one per job of the local run, and the cancelled one"
 
 # ---- same bytes -----------------------------------------------------------------------
+# .snakemake_timestamp is Snakemake's marker in a directory output (the virtual
+# experiment's raw/N<N>): the local run's are links into results/.cache (reuse across
+# runs), whose stored folders do not hold it; the SLURM profile does not reuse.
 compare() {
-    diff -r --brief --exclude=logs --exclude=benchmarks \
+    diff -r --brief --exclude=logs --exclude=benchmarks --exclude=.snakemake_timestamp \
         "$WORK/local/results/$RUN" "$WORK/slurm/results/$RUN"
 }
 compare || fail "results differ between the local and the SLURM run"

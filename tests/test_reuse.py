@@ -62,3 +62,21 @@ def test_every_cached_rule_of_the_workflow_restates_its_wildcards():
             assert "software=SOFTWARE" in params, (path.name, block[:40])
             checked += 1
     assert checked >= 25
+
+
+def test_a_figure_reused_across_runs_keeps_its_name_in_the_article(tmp_path):
+    """A reused figure is a link into results/.cache named by a hash: the article takes
+    the figure's name, caption and paragraph from the link, not from its target."""
+    from chain.report.text.article import figure_entries
+
+    store = tmp_path / "results" / ".cache"
+    store.mkdir(parents=True)
+    (store / "3f2a_pdf.pdf").write_bytes(b"%PDF-1.4\n")
+    figures = tmp_path / "results" / "again" / "figures"
+    figures.mkdir(parents=True)
+    link = figures / "fig4_delay_vs_force.pdf"
+    link.symlink_to(store / "3f2a_pdf.pdf")
+    text = {"section": "delays", "caption": "Delta against F_m", "paragraph": None}
+    (entry,) = figure_entries([link], tmp_path, {"fig4_delay_vs_force": text})
+    assert entry["name"] == "fig4_delay_vs_force" and entry["caption"] == text["caption"]
+    assert entry["path"] == "/results/again/figures/fig4_delay_vs_force.pdf"

@@ -429,7 +429,9 @@ def figure_entries(
     texts = texts or {}
     out = []
     for path in paths:
-        path = Path(path).resolve()
+        # Absolute, links not followed: a figure reused across runs is a link named by
+        # its provenance hash (results/.cache), its name is the link's.
+        path = Path(os.path.abspath(path))
         text = texts.get(path.stem) or figure_text(path.stem, {})
         out.append({"name": path.stem, "path": "/" + path.relative_to(root).as_posix(), **text})
     return out
@@ -461,8 +463,8 @@ def compile_article(
     """
     import typst  # here: a compiler the rest of the library does not need
 
-    source = Path(source).resolve()
-    figures = [Path(path).resolve() for path in figures]
+    source = Path(os.path.abspath(source))
+    figures = [Path(os.path.abspath(path)) for path in figures]
     root = Path(os.path.commonpath([source.parent, *figures]))
     document = dict(numbers, figures=figure_entries(figures, root, numbers.get("figure_text")))
     pdf = typst.compile(
