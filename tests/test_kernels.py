@@ -215,3 +215,19 @@ def test_skipping_beads_at_rest_gives_the_reference_bits(name, monkeypatch):
     # and, where the waves came near it, the skipped part shrank: a launch ran in parts
     assert (len(parts) > 2) == shrinks
     assert np.all(lean.refined_steps > 0)
+
+
+def test_a_long_chain_runs_the_kernel_a_short_chain_compiled():
+    """numba compiles the step loop (kernels._integrate_part) once per kind of model:
+    the whole-chain entry (_integrate_one) calls it with int64 arguments, as
+    chain.physics.at_rest does from Python, never with literal constants, for which
+    numba would compile the whole loop again (~13 s of a cold run, per kind)."""
+    from chain.physics.kernels import _integrate_part
+    from chain.physics.simulation import simulate
+
+    simulate(uniform_chain(4), [0.1], [0.1], duration=1e-5)
+    compiled = set(_integrate_part.signatures)
+    # A launch from one end only: the far beads are at rest and skipped (at_rest).
+    simulate(uniform_chain(400), [0.5], [0.0], duration=2e-4)
+    assert set(_integrate_part.signatures) == compiled
+    assert not [s for s in compiled if "Literal" in str(s)], compiled

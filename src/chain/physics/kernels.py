@@ -229,9 +229,14 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     at contact events."""
     links = (links, np.arange(links.shape[0]))
     particles = (particles, np.arange(particles.shape[0]))
+    # int64 variables, not the literals 0 and -1: numba specialises a callee on literal
+    # arguments, which compiled the whole loop twice per kind of model, once for this
+    # call and once for chain.physics.at_rest's (ints from Python are int64).
+    zero, no_gap = np.int64(0), np.int64(-1)
     status, step, refined, _, _, _ = _integrate_part(
-        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1
-    )
+        u, v, params, dt, zero, n_steps, record_every, links, particles, outputs,
+        zero, zero, 0.0, no_gap,
+    )  # fmt: skip
     return status, step, refined
 
 
