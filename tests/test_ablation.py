@@ -259,3 +259,48 @@ def virtual_experiment_settings_of(n_beads: int, sensors) -> dict:
         time_step_s=2.5e-7,
     )
     return dataclasses.asdict(settings)
+
+
+def test_fitting_every_estimator_gives_each_the_fits_it_gets_alone(tmp_path):
+    """A variant's job fits every estimator of the run, so that a what-if picking
+    another main estimator reuses it: each estimator's delay fits and SSW fits, its own
+    shot selection included, are those an analysis with that estimator alone gives,
+    to the bit."""
+    from chain.analysis.recipe import fit_pulses
+    from chain.analysis.rows import of_estimator
+    from chain.apparatus.virtual import run_virtual_experiment
+    from chain.studies.ablation import analyse_datasets, variant_fits
+    from chain.studies.mechanism_fits import variant_ssw_fits
+
+    chains = [
+        {**virtual_experiment_settings_of(n, sensors), "seed": 11 + n}
+        for n, sensors in ((16, (5, 12)), (17, (5, 13)))
+    ]
+    datasets = [tmp_path / f"N{c['n_beads']}" for c in chains]
+    for fields, folder in zip(chains, datasets, strict=True):
+        run_virtual_experiment(VirtualExperiment.from_dict(fields), folder, "virtual")
+    estimators = ("fit_full", "peak", "fit_rise")
+    traces, pulses, _ = analyse_datasets(datasets, None, estimators, "virtual")
+    fits, ssw_fits = variant_fits(traces, pulses, 0.05, estimators)
+    assert set(fits["estimator"]) == set(ssw_fits["estimator"]) == set(estimators)
+    for estimator in estimators:
+        alone_traces, alone, selection = analyse_datasets(datasets, 0.05, [estimator], "virtual")
+        expected = fit_pulses(alone, selection)
+        pd.testing.assert_frame_equal(of_estimator(fits, estimator), expected, check_exact=True)
+        expected_ssw = variant_ssw_fits(alone_traces, alone, selection, estimator)
+        pd.testing.assert_frame_equal(
+            of_estimator(ssw_fits, estimator).drop(columns="estimator"),
+            expected_ssw,
+            check_exact=True,
+        )
+        assert selection["kept"].any() and np.isfinite(expected["C_us_N16"]).any()
+
+
+def test_rows_of_an_estimator_need_the_column():
+    from chain.analysis.rows import of_estimator
+
+    table = pd.DataFrame({"estimator": ["peak", "fit_full", "peak"], "x": [1, 2, 3]})
+    assert of_estimator(table, "peak")["x"].tolist() == [1, 3]
+    assert list(of_estimator(table, "peak").index) == [0, 1]
+    with pytest.raises(KeyError, match="estimator"):
+        of_estimator(table.drop(columns="estimator"), "peak")

@@ -40,7 +40,7 @@ rule ablation_variant:
         settings=ablation_settings,
         reads_run=ablation_reads_run,
         tolerance=ablation_tolerance,
-        estimators=[config["analysis"]["main_estimator"]],
+        estimators=config["analysis"]["estimators"],
         series=PLAN.virtual_name,
         software=SOFTWARE,
         variant=restate("variant"),
@@ -81,6 +81,7 @@ rule ablation_table:
         ENV
     params:
         variants=lambda wildcards: ablation_names(wildcards.which),
+        estimator=config["analysis"]["main_estimator"],
         overrides={name: overrides_text(v) for name, v in PLAN.ablation.items()},
         software=SOFTWARE,
         which=restate("which"),

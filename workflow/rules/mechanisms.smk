@@ -52,7 +52,7 @@ rule lammps_setting:
     params:
         config=MECHANISM_CONFIG,
         sensors=lambda wildcards: list(PLAN.chains[int(wildcards.N)]),
-        estimator=config["analysis"]["main_estimator"],
+        estimators=config["analysis"]["estimators"],
         software=SOFTWARE,
         N=restate("N"),
         setting=restate("setting"),
@@ -99,6 +99,7 @@ rule ssw_mechanisms:
         lammps_reference=PLAN.frictionless,
         candidates=lambda wildcards: candidates_of(wildcards.which),
         candidate_reference=CANDIDATE_REFERENCE,
+        estimator=config["analysis"]["main_estimator"],
         software=SOFTWARE,
         which=restate("which"),
     script:

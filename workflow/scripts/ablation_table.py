@@ -1,15 +1,20 @@
 """tables/ablation_exponent.csv from the fits of every ablation variant
-(chain.studies.ablation_table.ablation_table)."""
+(chain.studies.ablation_table.ablation_table): the rows of the run's main estimator
+(params estimator; each variant's job fits every estimator)."""
 
 import pandas as pd
 from _logging import start
 
+from chain.analysis.rows import of_estimator
 from chain.atomic import write_csv_atomic
 from chain.studies.ablation_table import ablation_table
 
 log = start(snakemake)
 p = snakemake.params
-fits = {name: pd.read_csv(path) for name, path in zip(p.variants, snakemake.input.fits)}
+fits = {
+    name: of_estimator(pd.read_csv(path), p.estimator)
+    for name, path in zip(p.variants, snakemake.input.fits)
+}
 table = ablation_table(fits, p.overrides)
 log.info("%d rows", len(table))
 write_csv_atomic(table, snakemake.output[0])

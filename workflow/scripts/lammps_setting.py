@@ -1,5 +1,5 @@
 """One friction/rotation setting on one chain, run by LAMMPS and analysed
-(chain.studies.lammps_sweep.run_sweep_setting)."""
+(chain.studies.lammps_sweep.run_sweep_setting), with every estimator of the run."""
 
 from _logging import start
 
@@ -14,7 +14,7 @@ out = run_sweep_setting(
     int(w.N),
     snakemake.params.sensors,
     w.setting,
-    snakemake.params.estimator,
+    snakemake.params.estimators,
 )
 write_traces(out["traces"], snakemake.output.traces)
 for name in ("runs", "delay_fits", "ssw_fits"):

@@ -137,3 +137,27 @@ def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict
             "nan": int(np.sum(nan)),
         }
     return counts
+
+
+def of_estimator(table: pd.DataFrame, estimator: str) -> pd.DataFrame:
+    """The rows of ``table`` made with pulse estimator ``estimator``, in their order.
+
+    A study's job fits every estimator of the run (the rows say which in their
+    ``estimator`` column), so that a what-if that only picks another main estimator
+    reuses the job; the table that reports the study takes the main one's rows here.
+
+    Parameters
+    ----------
+    table : DataFrame
+        Rows with an ``estimator`` column (:data:`chain.analysis.pulses.ESTIMATORS`).
+    estimator : str
+        The estimator whose rows are kept.
+
+    Returns
+    -------
+    DataFrame
+        Those rows, indexed 0..n-1.
+    """
+    if "estimator" not in table:
+        raise KeyError(f"no 'estimator' column to pick {estimator!r} rows from")
+    return table[table["estimator"] == estimator].reset_index(drop=True)

@@ -26,10 +26,12 @@ import pandas as pd
 
 from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.recipe import fit_pulses
+from chain.analysis.rows import of_estimator
 from chain.analysis.selection import select_shots
 from chain.apparatus.measured import load_dataset
 from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 from chain.labels import VIRTUAL_SERIES
+from chain.studies.mechanism_fits import variant_ssw_fits
 
 
 def run_variant(
@@ -127,3 +129,47 @@ def analyse_datasets(
     if tolerance is not None:
         selection = select_shots(table, tolerance, estimator=estimators[0])
     return traces, table, selection
+
+
+def variant_fits(
+    traces: Sequence[pd.DataFrame],
+    pulses: pd.DataFrame,
+    tolerance: float | None,
+    estimators: Sequence[str],
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """A variant's delay fits and SSW fits at S2 with each estimator, each with the
+    shot selection the acceptance protocol makes with that estimator.
+
+    Every estimator is fitted so that a what-if choosing another main estimator
+    reuses the variant (its simulation is the costly part); the tables reporting it
+    take the main estimator's rows (:func:`chain.analysis.rows.of_estimator`).
+
+    Parameters
+    ----------
+    traces : sequence of DataFrame
+        The trace table of each chain (:func:`run_variant_shots`).
+    pulses : DataFrame
+        Their pulse rows with every estimator of ``estimators``.
+    tolerance : float or None
+        Acceptance tolerance of the 5 % protocol (relative); None keeps every shot.
+    estimators : sequence of str
+        Pulse estimators.
+
+    Returns
+    -------
+    fits : DataFrame
+        :func:`chain.analysis.recipe.fit_pulses` rows, one estimator after the other.
+    ssw_fits : DataFrame
+        :func:`chain.studies.mechanism_fits.variant_ssw_fits` rows, likewise, with an
+        ``estimator`` column.
+    """
+    fits, ssw_fits = [], []
+    for estimator in estimators:
+        rows = of_estimator(pulses, estimator)
+        selection = None
+        if tolerance is not None:
+            selection = select_shots(rows, tolerance, estimator=estimator)
+        fits.append(fit_pulses(rows, selection))
+        ssw = variant_ssw_fits(traces, rows, selection, estimator)
+        ssw_fits.append(ssw.assign(estimator=estimator))
+    return pd.concat(fits, ignore_index=True), pd.concat(ssw_fits, ignore_index=True)

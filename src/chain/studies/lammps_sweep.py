@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 import pandas as pd
 
 from chain.apparatus.lammps_shots import lammps_shots
-from chain.studies.mechanism_fits import analyse_traces
+from chain.studies.mechanism_fits import analyse_per_estimator
 from chain.studies.mechanism_settings import (
     granular_chain,
     sweep_settings,
@@ -19,7 +19,7 @@ from chain.studies.mechanism_settings import (
 
 
 def run_sweep_setting(
-    config: Mapping, n_beads: int, sensors: Sequence[int], name: str, estimator: str
+    config: Mapping, n_beads: int, sensors: Sequence[int], name: str, estimators: Sequence[str]
 ) -> dict[str, pd.DataFrame]:
     """One setting of the friction/rotation sweep on one chain, run and analysed.
 
@@ -35,14 +35,14 @@ def run_sweep_setting(
         A name of :func:`sweep_settings` or :func:`viscous_settings` (full lists); it is
         the traces' ``model``. Viscous settings run on the frictionless track with the
         viscous force instead of Kuwabara-Kono.
-    estimator : str
-        Pulse estimator.
+    estimators : sequence of str
+        Pulse estimators: the fits of each, tagged (reporting tables pick the main one).
 
     Returns
     -------
     dict
         ``traces``, ``runs`` (:func:`chain.apparatus.lammps_shots.lammps_shots`),
-        ``delay_fits`` and ``ssw_fits`` (:func:`analyse_traces`).
+        ``delay_fits`` and ``ssw_fits`` (:func:`analyse_per_estimator`).
     """
     options = config["lammps"]
     viscous = viscous_settings(config, full=True)
@@ -67,5 +67,5 @@ def run_sweep_setting(
         dt=options["time_step_s"],
         record_interval=options["record_interval_s"],
     )
-    delay_fits, ssw_fits = analyse_traces(traces, estimator)
+    delay_fits, ssw_fits = analyse_per_estimator(traces, estimators)
     return {"traces": traces, "runs": runs, "delay_fits": delay_fits, "ssw_fits": ssw_fits}

@@ -40,6 +40,32 @@ def analyse_traces(traces: pd.DataFrame, estimator: str) -> tuple[pd.DataFrame, 
     return fit_pulses(pulses), ssw_fit_table(ssw[ssw["sensor"] == "S2"])
 
 
+def analyse_per_estimator(
+    traces: pd.DataFrame, estimators: Sequence[str]
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`analyse_traces` with each estimator, rows tagged with it.
+
+    Parameters
+    ----------
+    traces : DataFrame
+        A trace table (collision and reference shots per amplitude).
+    estimators : sequence of str
+        Pulse estimators (:data:`chain.analysis.pulses.ESTIMATORS`).
+
+    Returns
+    -------
+    delay_fits, ssw_fits : DataFrame
+        Those of :func:`analyse_traces`, one estimator after the other, with an
+        ``estimator`` column (:func:`chain.analysis.rows.of_estimator` picks one).
+    """
+    delay_fits, ssw_fits = [], []
+    for estimator in estimators:
+        delays, ssw = analyse_traces(traces, estimator)
+        delay_fits.append(delays.assign(estimator=estimator))
+        ssw_fits.append(ssw.assign(estimator=estimator))
+    return pd.concat(delay_fits, ignore_index=True), pd.concat(ssw_fits, ignore_index=True)
+
+
 def variant_ssw_fits(
     traces: Sequence[pd.DataFrame],
     pulses: pd.DataFrame,
