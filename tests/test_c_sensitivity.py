@@ -16,6 +16,7 @@ from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
 from chain.report.numbers.spread import ablation_summary, c_spread_summary
 from chain.report.text.markdown_studies import spread_markdown_rows
 from chain.studies.c_sensitivity import (
+    c_sensitivity_every_estimator,
     c_sensitivity_table,
     sensitivity_plan,
     shifted_pairs,
@@ -42,8 +43,8 @@ def test_plan_of_the_paper_config():
 
 
 @pytest.fixture(scope="module")
-def small_table():
-    """A 16-bead chain, four launch speeds, eta 0 / 0.58 / 1.16 us."""
+def small_study():
+    """(traces, plan): a 16-bead chain, four launch speeds, eta 0 / 0.58 / 1.16 us."""
     chains = {16: [6, 11]}
     plan = {
         "chains": chains,
@@ -60,7 +61,34 @@ def small_table():
             model, plan["speeds_m_s"], [4, 6, 11, 13], model_name="m", duration=1.4e-3
         )
         traces[eta] = {16: table}
-    return c_sensitivity_table(traces, plan)
+    return traces, plan
+
+
+@pytest.fixture(scope="module")
+def small_table(small_study):
+    return c_sensitivity_table(*small_study)
+
+
+def test_the_main_estimators_table_is_picked_with_the_same_bytes(small_study, tmp_path):
+    """The study's job writes the table for every estimator as the headline one; the
+    reported table, picked from that file for the main estimator (rule
+    c_sensitivity_table), has the bytes of the table computed for it alone."""
+    from chain.analysis.rows import picked
+    from chain.atomic import write_csv_atomic
+
+    traces, plan = small_study
+    study = {k: v for k, v in plan.items() if k != "main_estimator"}
+    every = tmp_path / "every_estimator.csv"
+    write_csv_atomic(c_sensitivity_every_estimator(traces, study), every)
+    headlines = []
+    for estimator in plan["estimators"]:
+        alone = c_sensitivity_table(traces, {**plan, "main_estimator": estimator})
+        write_csv_atomic(alone, tmp_path / "alone.csv")
+        table = picked(pd.read_csv(every), "main_estimator", estimator)
+        write_csv_atomic(table, tmp_path / "picked.csv")
+        assert (tmp_path / "picked.csv").read_bytes() == (tmp_path / "alone.csv").read_bytes()
+        headlines.append(alone.loc[alone["headline"], "estimator"].unique().tolist())
+    assert headlines == [[e] for e in plan["estimators"]]
 
 
 def test_elastic_row_has_the_hertz_exponent(small_table):

@@ -18,9 +18,29 @@ rule mechanisms:
         f"{TABLES}/ssw_mechanisms_all.csv",
 
 
+# Every estimator (the simulations are the cost); lammps_check_table picks the main one.
 rule lammps_check:
     input:
         code("lammps_check"),
+    output:
+        f"{OUT}/lammps/check_every_estimator.csv",
+    log:
+        f"{LOGS}/lammps/check.log",
+    cache: REUSE
+    conda:
+        ENV
+    params:
+        config=MECHANISM_CONFIG,
+        estimators=config["analysis"]["estimators"],
+        software=SOFTWARE,
+    script:
+        "../scripts/lammps_check.py"
+
+
+rule lammps_check_table:
+    input:
+        table=f"{OUT}/lammps/check_every_estimator.csv",
+        lib=code("main_estimator_rows"),
     output:
         f"{TABLES}/lammps_check.csv",
     log:
@@ -29,11 +49,11 @@ rule lammps_check:
     conda:
         ENV
     params:
-        config=MECHANISM_CONFIG,
+        column="estimator",
         estimator=config["analysis"]["main_estimator"],
         software=SOFTWARE,
     script:
-        "../scripts/lammps_check.py"
+        "../scripts/main_estimator_rows.py"
 
 
 rule lammps_setting:

@@ -1,4 +1,5 @@
-"""LAMMPS against our kernel in the frictionless 1D limit (chain.studies.lammps_check)."""
+"""LAMMPS against our kernel in the frictionless 1D limit (chain.studies.lammps_check),
+with every estimator of the run (rule lammps_check_table picks the main one)."""
 
 from _logging import start
 
@@ -6,12 +7,13 @@ from chain.atomic import write_csv_atomic
 from chain.studies.lammps_check import run_lammps_check
 
 log = start(snakemake)
-table = run_lammps_check(snakemake.params.config, snakemake.params.estimator)
+table = run_lammps_check(snakemake.params.config, snakemake.params.estimators)
 for row in table.itertuples(index=False):
     log.info(
-        "N = %d %s: C kernel %.6f, LAMMPS %.6f (rel %.2g); traces within %.2g F_m",
+        "N = %d %s, %s: C kernel %.6f, LAMMPS %.6f (rel %.2g); traces within %.2g F_m",
         row.N,
         row.model,
+        row.estimator,
         row.C_kernel,
         row.C_lammps,
         row.rel_diff_C,

@@ -161,3 +161,30 @@ def of_estimator(table: pd.DataFrame, estimator: str) -> pd.DataFrame:
     if "estimator" not in table:
         raise KeyError(f"no 'estimator' column to pick {estimator!r} rows from")
     return table[table["estimator"] == estimator].reset_index(drop=True)
+
+
+def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
+    """The rows of ``table`` whose ``column`` is ``value``, without that column.
+
+    A study whose report depends on the run's main estimator computes its table for
+    every estimator, tagged in ``column``; the reporting job picks the main one's rows
+    here, so that the table is the one the study would have written for it alone.
+
+    Parameters
+    ----------
+    table : DataFrame
+        Rows tagged in ``column``.
+    column : str
+        The tag column (e.g. ``estimator``, ``main_estimator``).
+    value : str
+        The tag of the rows kept.
+
+    Returns
+    -------
+    DataFrame
+        Those rows in their order, indexed 0..n-1, ``column`` dropped.
+    """
+    if column not in table:
+        raise KeyError(f"no {column!r} column to pick {value!r} rows from")
+    rows = table[table[column].astype(str) == str(value)]
+    return rows.drop(columns=column).reset_index(drop=True)

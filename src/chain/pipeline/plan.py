@@ -294,6 +294,13 @@ class RunPlan:
         (:func:`chain.studies.c_sensitivity.sensitivity_plan`, the run's speeds)."""
         return sensitivity_plan(self.config, list(self.speeds))
 
+    @cached_property
+    def c_sensitivity_study(self) -> dict:
+        """:attr:`c_sensitivity` without the main estimator: the study's job computes
+        the table for every estimator as the headline one, so that a what-if choosing
+        another main estimator reuses its simulations."""
+        return {k: v for k, v in self.c_sensitivity.items() if k != "main_estimator"}
+
     def c_sensitivity_jobs(self) -> list[dict]:
         """The simulate jobs of the C-sensitivity study, per eta then chain: every bead
         of every sensor pair recorded (:meth:`simulate_job` inputs)."""

@@ -185,3 +185,32 @@ def _rows(choice, value, fits, estimator, eta, pairs, amplitudes, chains, eta_pa
             "headline": headline,
             "note": note,
         }
+
+
+def c_sensitivity_every_estimator(
+    traces: Mapping[float, Mapping[int, pd.DataFrame]], plan: Mapping
+) -> pd.DataFrame:
+    """:func:`c_sensitivity_table` with each estimator of ``plan`` as the headline one.
+
+    The study's job computes this (its simulations are the cost), so that a what-if
+    choosing another main estimator reuses it; the reported table is the main
+    estimator's rows (``chain.analysis.rows.picked``).
+
+    Parameters
+    ----------
+    traces : mapping
+        As :func:`c_sensitivity_table`.
+    plan : mapping
+        As :func:`c_sensitivity_table`; a ``main_estimator`` in it is not used.
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`C_SENSITIVITY_COLUMNS`, then ``main_estimator``: each
+        estimator's table after the other.
+    """
+    tables = [
+        c_sensitivity_table(traces, {**plan, "main_estimator": e}).assign(main_estimator=e)
+        for e in plan["estimators"]
+    ]
+    return pd.concat(tables, ignore_index=True)

@@ -8,7 +8,7 @@ their C must agree. This module maps config keys and knows no Snakemake.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -95,8 +95,9 @@ def _c_of(fits: pd.DataFrame) -> tuple[float, float]:
     return float(row["C_us_N16"]), float(row["C_stderr_us_N16"])
 
 
-def run_lammps_check(config: Mapping, estimator: str) -> pd.DataFrame:
-    """The cross-check of every configured chain and model (``lammps_check.csv``).
+def run_lammps_check(config: Mapping, estimators: Sequence[str]) -> pd.DataFrame:
+    """The cross-check of every configured chain and model (``lammps_check.csv``), with
+    each estimator.
 
     For each chain (N, sensors) and model (eta): the same collision and reference shots
     at ``lammps.check_speeds_m_s`` by our kernel (its default step) and by LAMMPS
@@ -106,8 +107,14 @@ def run_lammps_check(config: Mapping, estimator: str) -> pd.DataFrame:
     ----------
     config : mapping
         A schema-valid config.
-    estimator : str
-        Pulse estimator of the C fits.
+    estimators : sequence of str
+        Pulse estimators of the C fits.
+
+    Returns
+    -------
+    DataFrame
+        :data:`CHECK_COLUMNS`, then ``estimator``: one row per chain, model and
+        estimator (``chain.analysis.rows.picked`` gives one estimator's table).
     """
     options = config["lammps"]
     speeds = options["check_speeds_m_s"]
@@ -135,8 +142,10 @@ def run_lammps_check(config: Mapping, estimator: str) -> pd.DataFrame:
                 dt=options["time_step_s"],
                 record_interval=options["record_interval_s"],
             )
-            row = check_row(kernel, lammps, estimator=estimator, model=model["name"], eta=eta)
-            row["dt_kernel_s"] = shot_time_step(chain, speeds, None, options["record_interval_s"])
-            row["dt_lammps_s"] = options["time_step_s"]
-            rows.append(row)
-    return pd.DataFrame(rows, columns=CHECK_COLUMNS)
+            dt_kernel = shot_time_step(chain, speeds, None, options["record_interval_s"])
+            for estimator in estimators:
+                row = check_row(kernel, lammps, estimator=estimator, model=model["name"], eta=eta)
+                row["dt_kernel_s"] = dt_kernel
+                row["dt_lammps_s"] = options["time_step_s"]
+                rows.append({**row, "estimator": estimator})
+    return pd.DataFrame(rows, columns=[*CHECK_COLUMNS, "estimator"])
