@@ -412,22 +412,25 @@ def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
 
 def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
     """A what-if changing only an analysis key reuses every simulation, the virtual
-    experiment and the tracks; the analysis the key changes runs again."""
+    experiment, the tracks and the studies' simulations (their jobs fit every
+    estimator); the analysis the key changes runs again, and so do the tables that take
+    the main estimator's rows of the studies."""
     work, _, env, _ = checkout_copy(tiny[0], tmp_path)
     overlay = tmp_path / "peak.yaml"
-    # Studies off, as in the shipped what-ifs: the ablation variants and the LAMMPS
-    # runs simulate and analyse in one job (the estimator is among their params).
-    overlay.write_text(
-        "run_name: peak\nanalysis:\n  main_estimator: peak\nstudies:\n"
-        "  ablation: false\n  c_sensitivity: false\n  mechanisms: false\n"
-    )
+    overlay.write_text("run_name: peak\nanalysis:\n  main_estimator: peak\n")
     args = ["--cores", "2", "--configfile", str(TINY), str(overlay)]
     result = run(args, work, env)
     assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
     jobs = ran(work / "results" / "peak")
-    simulations = {j for j in jobs if j.startswith(("simulate/", "lammps/", "experiment/virtual"))}
+    simulations = {
+        j
+        for j in jobs
+        if j.startswith(("simulate/", "lammps/", "experiment/virtual", "ablation/", "c_sens"))
+    }
     assert simulations == set(), jobs
     assert {"tables/ssw.log", "experiment/selection.log"} <= jobs, jobs
+    studies = {"tables/ablation_exponent.log", "tables/c_sensitivity.log"}
+    assert studies | {"tables/ssw_mechanisms.log"} <= jobs, jobs
     assert "tables/pulses.log" not in jobs  # every estimator's pulses are computed anyway
 
 
