@@ -435,18 +435,18 @@ def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
 
 
 def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
-    """Every result of the tiny run (2 cores; stored, its files are links into
-    results/.cache) recomputed by ``--forceall --cores 1 --config reuse=False`` under
-    another string-hash seed: every job runs, nothing is stored or read from the store,
-    and each result has the same bytes. One run shows that a reused result is the
-    recomputed one, that a second build gives the same bytes, and that 1 core gives
-    those of 2 (summary.md and the article state the config, whose hash ``reuse``
-    changes: their bytes twice in a row are test_reproducibility's interrupted runs)."""
+    """Every result of the tiny run (stored: its files are links into results/.cache)
+    recomputed by ``--forceall --config reuse=False`` under another string-hash seed:
+    every job runs, nothing is stored or read from the store, and each result has the
+    same bytes. One run shows that a reused result is the recomputed one and that a
+    second build gives the same bytes (summary.md and the article state the config,
+    whose hash ``reuse`` changes: their bytes twice in a row, and on 1 core against 2,
+    are test_reproducibility's)."""
     work, out, env, _ = checkout_copy(tiny[0], tmp_path)
     cache = work / "results" / ".cache"
     stored = sorted(p.name for p in cache.iterdir())
     assert any(p.is_symlink() for p in out.rglob("*"))  # the tiny run's results are stored
-    args = ["--forceall", "--cores", "1", "--configfile", str(TINY), "--config", "reuse=False"]
+    args = ["--forceall", "--cores", "2", "--configfile", str(TINY), "--config", "reuse=False"]
     result = run(args, work, {**env, "PYTHONHASHSEED": "2"})
     assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
     assert not any(p.is_symlink() for p in out.rglob("*"))  # each result computed here
