@@ -8,7 +8,7 @@ figures, and the report without an integrator.
       report               -> analysis, physics.theory/materials
     apparatus | analysis   (side by side, no arrow between them)
     physics                -> errors only
-    errors, atomic, csv_text, traces, labels, _lazy
+    errors, atomic, csv_text, traces, labels, sampling, _lazy
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ BOTTOM = {
     "chain.csv_text",
     "chain.traces",
     "chain.labels",
+    "chain.sampling",
 }
 
 #: Wing -> the chain modules or wings (prefixes) it may import.

@@ -34,6 +34,7 @@ import pandas as pd
 
 from chain.atomic import write_csv_atomic
 from chain.errors import bead_number_problem
+from chain.sampling import TIME_STEP_TOLERANCE
 
 #: Columns every trace table has, in order, before the sensor columns.
 META_COLUMNS = (
@@ -135,7 +136,8 @@ def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataF
         step = np.diff(time)
         if np.any(step <= 0):
             raise TraceFormatError(f"{where}: shot {shot}: time is not strictly increasing")
-        if np.ptp(step) > 1e-3 * np.median(step):
+        median = np.median(step)
+        if np.any(np.abs(step - median) > TIME_STEP_TOLERANCE * median):
             raise TraceFormatError(f"{where}: shot {shot}: time is not evenly sampled")
     return out
 

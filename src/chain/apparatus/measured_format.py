@@ -6,6 +6,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+# How evenly a shot file's time must step (against sampling_interval_s): the trace
+# table's own rule, re-exported for the readers here.
+from chain.sampling import TIME_STEP_TOLERANCE as TIME_STEP_TOLERANCE
+
 #: Name of the metadata file of a dataset.
 METADATA_FILE = "metadata.yaml"
 
@@ -18,9 +22,6 @@ TIME_COLUMN = "t_s"
 #: Standard gravity used to turn a drop height into an impact speed, m/s^2.
 STANDARD_GRAVITY = 9.80665
 
-#: Largest deviation of a time step from ``sampling_interval_s``, as a fraction of it.
-#: Generous enough for times exported with 6 significant digits.
-TIME_STEP_TOLERANCE = 0.01
 
 #: At most this many problems are listed for one dataset (the rest are counted).
 MAX_PROBLEMS = 20
