@@ -217,17 +217,10 @@ def test_a_variant_reading_the_runs_experiment_gets_what_simulating_gives(tmp_pa
     """A replicate with the run's own settings reads the run's virtual experiment
     (RunPlan.ablation_datasets) instead of simulating it: the same traces, pulses and
     selection, to the bit, as simulating those shots again, noise and mismatch included."""
-    from chain.apparatus.virtual import run_virtual_experiment
     from chain.studies import ablation
     from chain.studies.ablation import run_variant_shots
 
-    chains = [
-        {**virtual_experiment_settings_of(n, sensors), "seed": 7 + n}
-        for n, sensors in ((16, (5, 12)), (17, (5, 13)))
-    ]
-    datasets = [tmp_path / f"N{c['n_beads']}" for c in chains]
-    for fields, folder in zip(chains, datasets, strict=True):
-        run_virtual_experiment(VirtualExperiment.from_dict(fields), folder, "virtual")
+    chains, datasets = written_datasets(tmp_path, seed=7)
     simulated = run_variant_shots(chains, 0.05, series="virtual")
 
     def no_simulation(*args, **kwargs):
@@ -240,6 +233,21 @@ def test_a_variant_reading_the_runs_experiment_gets_what_simulating_gives(tmp_pa
     pd.testing.assert_frame_equal(simulated[1], shared[1], check_exact=True)
     pd.testing.assert_frame_equal(simulated[2], shared[2], check_exact=True)
     assert len(shared[1]) > 0 and shared[2]["kept"].any()
+
+
+def written_datasets(folder: Path, seed: int) -> tuple[list[dict], list[Path]]:
+    """Two small virtual experiments (N = 16, 17; seeds ``seed`` + N) written as
+    datasets under ``folder``: (their settings, their folders)."""
+    from chain.apparatus.virtual import run_virtual_experiment
+
+    chains = [
+        {**virtual_experiment_settings_of(n, sensors), "seed": seed + n}
+        for n, sensors in ((16, (5, 12)), (17, (5, 13)))
+    ]
+    datasets = [folder / f"N{c['n_beads']}" for c in chains]
+    for fields, target in zip(chains, datasets, strict=True):
+        run_virtual_experiment(VirtualExperiment.from_dict(fields), target, "virtual")
+    return chains, datasets
 
 
 def virtual_experiment_settings_of(n_beads: int, sensors) -> dict:
@@ -268,17 +276,10 @@ def test_fitting_every_estimator_gives_each_the_fits_it_gets_alone(tmp_path):
     to the bit."""
     from chain.analysis.recipe import fit_pulses
     from chain.analysis.rows import of_estimator
-    from chain.apparatus.virtual import run_virtual_experiment
     from chain.studies.ablation import analyse_datasets, variant_fits
     from chain.studies.mechanism_fits import variant_ssw_fits
 
-    chains = [
-        {**virtual_experiment_settings_of(n, sensors), "seed": 11 + n}
-        for n, sensors in ((16, (5, 12)), (17, (5, 13)))
-    ]
-    datasets = [tmp_path / f"N{c['n_beads']}" for c in chains]
-    for fields, folder in zip(chains, datasets, strict=True):
-        run_virtual_experiment(VirtualExperiment.from_dict(fields), folder, "virtual")
+    _, datasets = written_datasets(tmp_path, seed=11)
     estimators = ("fit_full", "peak", "fit_rise")
     traces, pulses, _ = analyse_datasets(datasets, None, estimators, "virtual")
     fits, ssw_fits = variant_fits(traces, pulses, 0.05, estimators)

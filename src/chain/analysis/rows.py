@@ -158,9 +158,7 @@ def of_estimator(table: pd.DataFrame, estimator: str) -> pd.DataFrame:
     DataFrame
         Those rows, indexed 0..n-1.
     """
-    if "estimator" not in table:
-        raise KeyError(f"no 'estimator' column to pick {estimator!r} rows from")
-    return table[table["estimator"] == estimator].reset_index(drop=True)
+    return _tagged(table, "estimator", estimator)
 
 
 def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
@@ -184,7 +182,12 @@ def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
     DataFrame
         Those rows in their order, indexed 0..n-1, ``column`` dropped.
     """
+    return _tagged(table, column, value).drop(columns=column)
+
+
+def _tagged(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
+    # The rows whose tag is ``value``, in their order, indexed 0..n-1 (tags compared as
+    # text: a table read back from CSV holds what was written).
     if column not in table:
         raise KeyError(f"no {column!r} column to pick {value!r} rows from")
-    rows = table[table[column].astype(str) == str(value)]
-    return rows.drop(columns=column).reset_index(drop=True)
+    return table[table[column].astype(str) == str(value)].reset_index(drop=True)
