@@ -4,8 +4,6 @@
 
 import os
 
-from chain.pipeline.provenance import run_provenance
-
 ARTICLE_SOURCE = os.path.relpath(
     Path(workflow.basedir) / "workflow" / "report" / "article.typ", Path.cwd()
 )
@@ -39,6 +37,6 @@ rule article:
         },
         # Commit, commit date, config hash and versions: a changed commit or
         # configuration rebuilds the article, which states them.
-        provenance=run_provenance(config, workflow.basedir),
+        provenance=PROVENANCE,
     script:
         "../scripts/article.py"

@@ -17,6 +17,7 @@ from chain.pipeline.datasets import (
 )
 from chain.pipeline.deps import script_sources
 from chain.pipeline.plan import RunPlan
+from chain.pipeline.provenance import run_provenance
 from chain.pipeline.reuse import (
     CACHE_VARIABLE,
     cache_folder,
@@ -38,6 +39,9 @@ os.environ[CACHE_VARIABLE] = str(cache_folder(os.environ, Path.cwd()))
 Path(os.environ[CACHE_VARIABLE]).mkdir(parents=True, exist_ok=True)
 # Versions the provenance hash does not see; a `software` param of each cached rule.
 SOFTWARE = software_versions()
+# Commit, config hash and installed versions (summary.json and the article state them):
+# read once (git, the installed distributions), not once per rule that states them.
+PROVENANCE = run_provenance(config, workflow.basedir)
 
 
 def restate(name):

@@ -1,6 +1,5 @@
 # The summary beside the paper's numbers, and the HTML report.
 
-from chain.pipeline.provenance import run_provenance
 from chain.studies.mechanism_table import FRICTION_MECHANISM, REFERENCE_MECHANISM
 
 
@@ -41,7 +40,7 @@ rule summary:
         # say they were not run).
         studies_not_run=PLAN.studies_not_run,
         # Commit, config hash, installed versions and how they compare with the lock.
-        provenance=run_provenance(config, workflow.basedir),
+        provenance=PROVENANCE,
     script:
         "../scripts/summary.py"
 
