@@ -53,3 +53,18 @@ def test_spacetime_figure_is_byte_reproducible(tracked, tmp_path):
     ]
     for first, second in zip(*paths):
         assert first.read_bytes() == second.read_bytes(), first.name
+
+
+def test_spacetime_figure_drawn_in_two_processes_has_the_bytes_of_one(tracked, tmp_path):
+    """The rule gives this figure two cores: PNG and PDF drawn at once, same bytes."""
+    fields, track = tracked
+    one, two = (
+        save_figure(
+            fig_ssw_spacetime(fields, track, "elastic"),
+            tmp_path / str(processes) / "ssw_spacetime",
+            processes=processes,
+        )
+        for processes in (1, 2)
+    )
+    for sequential, side_by_side in zip(one, two, strict=True):
+        assert sequential.read_bytes() == side_by_side.read_bytes(), sequential.name

@@ -521,6 +521,43 @@ def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
     assert mode & 0o044, "figures must be readable by others (not left at mkstemp's 0600)"
 
 
+@pytest.mark.parametrize("figure", ["fig3", "fig4", "fig5", "parity"])
+def test_pdf_and_png_drawn_at_once_have_the_bytes_of_one_after_the_other(
+    tmp_path, trace_inputs, figure
+):
+    """save_figure(processes=2) draws the PNG in a forked process: the same bytes."""
+    traces, pulses, ssw = trace_inputs
+    builders = {
+        "fig3": lambda: fig3_simulation_traces(traces, pulses, ssw, model="elastic"),
+        "fig4": lambda: fig4_delay_vs_force(
+            delays_table(),
+            delay_fits_table(),
+            constants={"C_bal_paper_us_N16": 49.75, "C_bal_exact_us_N16": 37.74},
+        ),
+        "fig5": lambda: fig5_ssw_vs_force(*ssw_tables()),
+        "parity": lambda: fig_parity_ssw_vs_N(ssw_tables()[1]),
+    }
+    one, two = (
+        style.save_figure(builders[figure](), tmp_path / str(n) / figure, processes=n)
+        for n in (1, 2)
+    )
+    for sequential, side_by_side in zip(one, two, strict=True):
+        assert sequential.read_bytes() == side_by_side.read_bytes(), sequential.name
+    assert sorted(p.name for p in two[0].parent.iterdir()) == [f"{figure}.pdf", f"{figure}.png"]
+
+
+def test_a_png_that_fails_in_its_process_fails_the_save_and_leaves_no_file(tmp_path, monkeypatch):
+    def broken(fig, target):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(style, "_save_png", broken)  # in the forked child too
+    fig = style.new_figure(2.0, 2.0)
+    fig.add_subplot().plot([0, 1], [1, 0])
+    with pytest.raises(RuntimeError, match=r"fails\.png failed in its process"):
+        style.save_figure(fig, tmp_path / "fails", processes=2)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fails.pdf"]
+
+
 def test_pdf_layout_pass_rasterizes_nothing_and_changes_no_byte(tmp_path, monkeypatch):
     """save_figure rasterizes a rasterized artist once for the PDF (its layout pass,
     which draws nothing, skips it) and writes the bytes matplotlib's own savefig does."""

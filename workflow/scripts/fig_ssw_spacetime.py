@@ -21,5 +21,5 @@ long_fields = {
 fig = fig_ssw_spacetime(
     fields, pd.read_csv(snakemake.input.track), snakemake.params.model, long_fields
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""), processes=snakemake.threads)
 log.info("done")

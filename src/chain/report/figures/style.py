@@ -8,7 +8,10 @@ state, no display backend). Editing this module redraws every figure, and nothin
 
 from __future__ import annotations
 
+import functools
 import os
+import sys
+import traceback
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -70,7 +73,7 @@ MICRO = 1e6
 # ---- saving ---------------------------------------------------------------------
 
 
-def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
+def save_figure(fig: Figure, path: str | os.PathLike, *, processes: int = 1) -> list[Path]:
     """Write ``fig`` as ``<path>.pdf`` and ``<path>.png`` with fixed metadata.
 
     Each file is written to a temporary name beside its destination and renamed, so
@@ -83,6 +86,10 @@ def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
         The figure.
     path : path
         Destination without extension; parent folders are created.
+    processes : int
+        Processes that may draw at once (a job's cores): with 2 or more (and
+        ``os.fork``), the PNG is drawn in a forked process while this one draws the PDF,
+        the same bytes as one after the other (``tests/test_figures.py``).
 
     Returns
     -------
@@ -93,17 +100,69 @@ def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
     if stem.suffix in (".pdf", ".png"):
         stem = stem.with_suffix("")
     stem.parent.mkdir(parents=True, exist_ok=True)
-    written = []
+    pdf, png = (stem.with_name(f"{stem.name}.{extension}") for extension in ("pdf", "png"))
     with mpl.rc_context(STYLE), _rasterize_only_when_drawing():
-        for extension, options in (
-            ("pdf", {"metadata": PDF_METADATA}),
-            ("png", {"metadata": PNG_METADATA, "dpi": PNG_DPI}),
-        ):
-            target = stem.with_name(f"{stem.name}.{extension}")
-            with atomic_output(target) as temporary:
-                fig.savefig(temporary, format=extension, **options)
-            written.append(target)
-    return written
+        if processes > 1 and hasattr(os, "fork"):
+            _save_side_by_side(fig, pdf, png)
+        else:
+            _save_pdf(fig, pdf)
+            _save_png(fig, png)
+    return [pdf, png]
+
+
+def _save_pdf(fig: Figure, target: Path) -> None:
+    with atomic_output(target) as temporary:
+        fig.savefig(temporary, format="pdf", metadata=PDF_METADATA)
+
+
+def _save_png(fig: Figure, target: Path) -> None:
+    with atomic_output(target) as temporary:
+        fig.savefig(temporary, format="png", metadata=PNG_METADATA, dpi=PNG_DPI)
+
+
+def _save_side_by_side(fig: Figure, pdf: Path, png: Path) -> None:
+    """The PDF drawn here and the PNG in a forked child, at the same time.
+
+    Saved one after the other, the PNG is drawn from the layout the PDF's save left
+    (constrained layout starts from the positions it finds): the child first lays the
+    figure out as the PDF's save does, drawing nothing, so that its PNG has the bytes
+    of the sequential save.
+    """
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()  # nothing buffered is written twice
+    child = os.fork()
+    if child == 0:
+        status = 1
+        try:
+            _lay_out_as_the_pdf_save_does(fig)
+            _save_png(fig, png)
+            status = 0
+        except BaseException:  # an interruption too: the atomic writer has cleaned up
+            traceback.print_exc()
+        finally:
+            sys.stderr.flush()
+            os._exit(status)
+    try:
+        _save_pdf(fig, pdf)
+    finally:
+        _, status = os.waitpid(child, 0)
+    if status != 0:
+        raise RuntimeError(f"writing {png} failed in its process (traceback above)")
+
+
+def _lay_out_as_the_pdf_save_does(fig: Figure) -> None:
+    """What ``savefig(format="pdf")`` does to a figure with a layout engine before it
+    draws: one draw with a PDF renderer, drawing switched off (matplotlib 3.11,
+    ``FigureCanvasBase.print_figure``)."""
+    from matplotlib.backend_bases import _get_renderer
+    from matplotlib.backends.backend_pdf import FigureCanvasPdf
+
+    if fig.get_layout_engine() is None:
+        return
+    canvas = FigureCanvasPdf(fig)
+    renderer = _get_renderer(fig, functools.partial(canvas.print_pdf, metadata=PDF_METADATA))
+    with renderer._draw_disabled():
+        fig.draw(renderer)
 
 
 @contextmanager
