@@ -171,7 +171,7 @@ rule ssw_track:
     log:
         f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
     cache: REUSE
-    priority: 1
+    priority: 3
     conda:
         ENV
     # Half the simulate job's work (collision shots only), same arrays per shot: the
