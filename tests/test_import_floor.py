@@ -4,7 +4,8 @@ Each job is a fresh interpreter, and numba, scipy, pandas and matplotlib each ta
 of a second to import (issue 33). The rules: ``import chain`` and its subpackages cost
 nothing; the analysis imports neither numba, matplotlib nor scipy until it fits (scipy
 where a function uses it); the report never imports numba or scipy; the Snakefile's
-config checks import neither numba nor scipy nor pandas; a figure job imports no numba
+config checks import neither numba nor scipy nor pandas, and its whole parse (run plan,
+job resources) neither numba nor scipy; a figure job imports no numba
 or scipy, and an analysis, summary or article job no numba or matplotlib; a log-log
 power-law fit (delay_fits, summary) imports no scipy.
 
@@ -96,6 +97,25 @@ CASES = {
     "the config checks and closed forms": (
         ["import chain.pipeline.config", "import chain.physics.theory"],
         {"numba", "scipy", "pandas", "matplotlib"},
+    ),
+    # What the Snakefile runs before any job (common.smk): every snakemake command, a
+    # dry run included, pays it.
+    "the workflow's parse: config checks, run plan, job resources": (
+        [
+            "import yaml",
+            "from snakemake.utils import validate",
+            "from chain.pipeline.config import check_config",
+            "from chain.pipeline.plan import RunPlan",
+            f"config = yaml.safe_load(open({str(ROOT / 'config.yaml')!r}))",
+            f"validate(config, {str(ROOT / 'workflow' / 'schemas' / 'config.schema.yaml')!r})",
+            "check_config(config)",
+            "plan = RunPlan(config)",
+            "chains = [*plan.chains, *plan.long_chains]",
+            "jobs = [plan.simulate_job(m, n) for m in plan.models for n in chains]",
+            "needs = [plan.simulation_needs(m, n, plan.simulation_threads(m, n))"
+            " for m in plan.models for n in chains]",
+        ],
+        {"numba", "scipy", "matplotlib"},
     ),
     "the figure jobs": (
         script_imports(sorted(p.stem for p in SCRIPTS.glob("fig*.py"))),

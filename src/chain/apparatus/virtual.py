@@ -47,13 +47,13 @@ from chain.apparatus.virtual_settings import (
     DEFAULT_IMPACT_SPEEDS_M_S,
     LAUNCHES,
     READOUTS,
+    TIME_STEP_COARSENING,
     VirtualExperiment,
     check_switches,
 )
 from chain.apparatus.virtual_shots import (
     MAX_BATCH,
     RECORD_OVERSAMPLING,
-    TIME_STEP_COARSENING,
     simulate_virtual_shots,
 )
 from chain.labels import VIRTUAL_LABEL

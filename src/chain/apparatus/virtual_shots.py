@@ -9,17 +9,16 @@ import math
 import numpy as np
 import pandas as pd
 
-from chain.apparatus.virtual_settings import CHAIN_STREAM, VirtualExperiment, check_switches
+from chain.apparatus.virtual_settings import (
+    CHAIN_STREAM,
+    TIME_STEP_COARSENING,
+    VirtualExperiment,
+    check_switches,
+)
 from chain.physics.builders import build_chain, uniform_chain
 from chain.physics.materials import contact_stiffness, sphere_mass
 from chain.physics.model import ChainModel, Striker
 from chain.physics.simulation import default_time_step, felt_contacts, simulate
-
-#: The virtual experiment integrates with this many times the conservative default step
-#: of :func:`chain.physics.simulation.default_time_step` (which aims at a 1e-9 energy drift).
-#: At 8x the sensor forces change by ~1e-6 relative (checked against 1x), far below
-#: the sensor noise and the ADC step, and a paper-sized run takes seconds.
-TIME_STEP_COARSENING = 8
 
 #: Simulated samples per digitiser interval; the digitiser interpolates between them.
 RECORD_OVERSAMPLING = 4

@@ -112,7 +112,7 @@ def _check_sensor_spring(config: Mapping, virtual: Mapping) -> None:
     """With a given time step, the split sensor bead's spring (halves of m / 2) keeps
     STEPS_PER_SPRING_PERIOD / TIME_STEP_COARSENING steps per period: the coarsening the
     virtual experiment's own default step allows (energy drift ~1e-6)."""
-    from chain.apparatus.virtual_shots import TIME_STEP_COARSENING
+    from chain.apparatus.virtual_settings import TIME_STEP_COARSENING
 
     step = virtual["time_step_s"]
     if step is None or virtual["readout"] != "sensor":
@@ -162,7 +162,7 @@ def _check_delay(config: Mapping, virtual: Mapping, speeds, ratios) -> None:
 def _check_tolerance(config: Mapping, settings) -> None:
     """The selection keeps MIN_KEPT_SHOTS collision shots of a chain, judged by the
     planned speeds of the shots (seeded, so known before any job)."""
-    from chain.apparatus.virtual import plan_shots
+    from chain.apparatus.virtual_plan import plan_shots
 
     tolerance = config["experiment"].get("tolerance")
     if tolerance is None:

@@ -62,8 +62,10 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+@cache
 def _module_file(root: Path, dotted: str) -> Path | None:
-    """The file of module ``dotted`` under the package folder ``root``, or None."""
+    """The file of module ``dotted`` under the package folder ``root``, or None (asked
+    thousands of times at parse time, for a few hundred names)."""
     relative = Path(*dotted.split(".")[1:])
     for candidate in (root / relative / "__init__.py", (root / relative).with_suffix(".py")):
         if candidate.is_file():
@@ -128,8 +130,5 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
             files.add(local)
         for target in _targets(root, module, names):
             files |= _package_closure(root, target)
-    return sorted(_relative(path) for path in files)
-
-
-def _relative(path: Path) -> str:
-    return os.path.relpath(path, Path.cwd().resolve())
+    here = Path.cwd().resolve()
+    return sorted(os.path.relpath(path, here) for path in files)

@@ -29,7 +29,7 @@ How the run time was estimated
 RK4 costs about the same per particle and step whatever the chain: at most
 :data:`SECONDS_PER_PARTICLE_STEP` on one core of this project's (shared, loaded) test
 machine. A job runs 2 B launches (collision and reference shots) of duration / dt steps
-each; dt is :func:`chain.physics.simulation.default_time_step` at the fastest launch
+each; dt is :func:`chain.physics.time_step.default_time_step` at the fastest launch
 unless the config sets it. The request is :data:`SAFETY` times that plus start-up, and
 never under :data:`MIN_RUNTIME_MIN` (queues round short jobs up anyway). Every paper
 job asks for the minimum; the estimate matters for long sweeps (N = 100, 5 ms,
@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 from chain.errors import require_int, require_positive
 from chain.physics.model import ChainModel
-from chain.physics.simulation import default_time_step
+from chain.physics.time_step import default_time_step
 
 #: Resident memory of the simulate script before it allocates traces, MB: the numba
 #: compilation peak with an empty cache (measured 590 MB; 200 MB with a warm cache).
@@ -143,7 +143,7 @@ def simulation_needs(
     record_interval : float
         Time between recorded samples, s.
     dt : float, optional
-        RK4 step, s; default :func:`chain.physics.simulation.default_time_step`.
+        RK4 step, s; default :func:`chain.physics.time_step.default_time_step`.
     threads : int
         Cores the job gets (launches run in parallel threads).
 
