@@ -201,8 +201,10 @@ def first_difference(a: Path, b: Path) -> str:
 
 #: Folders of intermediate files (consumed by one rule, kept for inspection): after an
 #: interruption Snakemake deletes those of the jobs it killed and does not remake them
-#: while everything downstream is complete and up to date.
-INTERMEDIATES = ("simulation/", "experiment/", "ablation/")
+#: while everything downstream is complete and up to date (c_sensitivity/: the every-
+#: estimator table that rule c_sensitivity_table reads, when the interruption hits the
+#: C-sensitivity job).
+INTERMEDIATES = ("simulation/", "experiment/", "ablation/", "c_sensitivity/")
 
 
 def assert_same_bytes(
