@@ -25,7 +25,8 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain.pipeline.headline import headline_numbers
-from chain.report.numbers.claims import NOT_COMPUTED, TOLERANCES, claims, with_claims
+from chain.report.numbers.claim_rows import NOT_COMPUTED, TOLERANCES
+from chain.report.numbers.claims import claims, with_claims
 from chain.report.numbers.summary import decisions
 from chain.report.printed import E_NOTATION, plus_minus
 from chain.report.text.article import CAPTIONS, article_numbers, compile_article

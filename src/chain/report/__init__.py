@@ -6,7 +6,8 @@ Three subpackages, by what they make, and two modules all three share:
 * :mod:`.numbers`: what the run found and what it means, decided once and written to
   ``summary.json``: the summary itself (:mod:`.numbers.summary`), the paper's own
   numbers (:mod:`.numbers.paper`, quoted as printed), the claims with their verdicts
-  against the tolerance table (:mod:`.numbers.claims`), the ablation and C-spread
+  against the tolerance table (:mod:`.numbers.claims`, :mod:`.numbers.ssw_claims`,
+  :mod:`.numbers.claim_rows`), the ablation and C-spread
   entries (:mod:`.numbers.spread`) and the mechanism study's verdict
   (:mod:`.numbers.mechanisms`).
 * :mod:`.text`: ``summary.md`` (:mod:`.text.markdown`) and the article

@@ -31,11 +31,8 @@ from chain.physics.theory import (
     ballistic_constants,
 )
 from chain.report.naming import series_names
-from chain.report.numbers.claims import (
-    TOLERANCES,
-    dissipation_verdicts,
-    energy_drift_within_paper,
-)
+from chain.report.numbers.claim_rows import TOLERANCES
+from chain.report.numbers.claims import dissipation_verdicts, energy_drift_within_paper
 from chain.report.numbers.paper import PAPER, PAPER_BEADS
 
 #: Significant digits of floats in summary.json.
@@ -198,7 +195,7 @@ def decisions(summary: Mapping) -> dict:
         ``ballistic_factors`` (Eq. 6's contact time against the exact one:
         ``reduced_mass_time_factor``, ``hertz_time_constant``, ``paper_time_constant``
         and their product ``exact_over_paper``, :mod:`chain.physics.theory`) and
-        ``verdicts``: the ``tolerances`` of :data:`chain.report.numbers.claims.TOLERANCES`,
+        ``verdicts``: the ``tolerances`` of :data:`chain.report.numbers.claim_rows.TOLERANCES`,
         ``dissipation`` (:func:`chain.report.numbers.claims.dissipation_verdicts`) and
         ``energy_drift_within_paper``. The claim table joins ``verdicts`` last
         (:func:`chain.report.numbers.claims.with_claims`).
