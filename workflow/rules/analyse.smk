@@ -171,6 +171,8 @@ rule ssw_track:
     log:
         f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
     cache: REUSE
+    # Before the tables: its long-chain jobs take 2 threads, and a what-if that links
+    # them from the store would otherwise wait for both cores to be free.
     priority: 3
     conda:
         ENV

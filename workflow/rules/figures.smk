@@ -159,8 +159,8 @@ rule ssw_spacetime:
     cache: REUSE
     conda:
         ENV
-    # PDF and PNG drawn at once (chain.report.figures.style.save_figure): 3.6 s
-    # against 7 s, most of it the field's ~3 million cells, drawn once per file.
+    # PDF and PNG drawn at once (chain.report.figures.style.save_figure): the save
+    # 5.0 s against 7.3 s, most of it the field's ~3 million cells, drawn per file.
     threads: 2
     params:
         model=SPACETIME_MODEL,
