@@ -438,8 +438,10 @@ def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     """Every result of the tiny run (stored: its files are links into results/.cache)
     recomputed by ``--forceall --config reuse=False`` under another string-hash seed:
     every job runs, nothing is stored or read from the store, and each result has the
-    same bytes. One run shows that a reused result is the recomputed one and that a
-    second build gives the same bytes (summary.md and the article state the config,
+    same bytes. Its jobs run each in its own process (``HERTZCHAIN_JOB_SERVER=off``),
+    the tiny run's in the job server (chain.pipeline.job_server). One run shows that a
+    reused result is the recomputed one, that a second build gives the same bytes and
+    that the job server changes none (summary.md and the article state the config,
     whose hash ``reuse`` changes: their bytes twice in a row, and on 1 core against 2,
     are test_reproducibility's)."""
     work, out, env, _ = checkout_copy(tiny[0], tmp_path)
@@ -447,8 +449,12 @@ def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     stored = sorted(p.name for p in cache.iterdir())
     assert any(p.is_symlink() for p in out.rglob("*"))  # the tiny run's results are stored
     args = ["--forceall", "--cores", "2", "--configfile", str(TINY), "--config", "reuse=False"]
-    result = run(args, work, {**env, "PYTHONHASHSEED": "2"})
+    server_log = work / ".snakemake" / "job_server.log"
+    assert "job server: ready" in server_log.read_text()  # the tiny run's jobs used it
+    server_log.unlink()
+    result = run(args, work, {**env, "PYTHONHASHSEED": "2", "HERTZCHAIN_JOB_SERVER": "off"})
     assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    assert not server_log.exists()
     assert not any(p.is_symlink() for p in out.rglob("*"))  # each result computed here
     assert sorted(p.name for p in cache.iterdir()) == stored
     assert differing_results(tiny[1], out) == [] and same_summary(tiny[1], out)

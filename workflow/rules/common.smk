@@ -16,6 +16,7 @@ from chain.pipeline.datasets import (
     check_experiment_datasets,
 )
 from chain.pipeline.deps import script_sources
+from chain.pipeline import job_server
 from chain.pipeline.plan import RunPlan
 from chain.pipeline.provenance import run_provenance
 from chain.pipeline.reuse import (
@@ -181,3 +182,27 @@ def simulate_runtime(wildcards, threads):
 VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
 # pulses, ssw: one trace file at a time, 185 MB peak; ~2 s per trace file.
 ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
+
+
+# ---- the job server (chain.pipeline.job_server) ------------------------------------
+# A local run's jobs run in children of one process that imported their libraries once
+# (pandas, scipy, numba, matplotlib: 1.5-2.5 s a job otherwise). Each job keeps its own
+# process, script, log and status, and the same bytes. Not on a cluster (each job on
+# its node, as before), nor with HERTZCHAIN_JOB_SERVER=off.
+JOB_SERVER = {}
+
+
+onstart:
+    if workflow.local_exec and workflow.is_main_process:
+        JOB_SERVER["process"] = job_server.start(
+            Path(workflow.basedir) / "workflow" / "scripts",
+            ".snakemake/job_server.log",
+        )
+
+
+onsuccess:
+    job_server.stop(JOB_SERVER.pop("process", None))
+
+
+onerror:
+    job_server.stop(JOB_SERVER.pop("process", None))

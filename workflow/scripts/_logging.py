@@ -46,4 +46,9 @@ def _use_job_threads(threads: int | None) -> None:
 
 
 def _terminate(signum, frame):
+    # Once: a job run by the job server (chain.pipeline.job_server) gets a signal sent
+    # to the process group both directly and from its client; a second SystemExit
+    # would cut the atomic writers' clean-up short.
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     raise SystemExit(128 + signum)

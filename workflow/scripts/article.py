@@ -2,6 +2,7 @@
 
 import json
 
+import _hand_off  # noqa: F401 (first: the job may run in the job server)
 from _logging import start
 
 from chain.report.text.article import article_numbers, compile_article

@@ -2,6 +2,7 @@
 
 from pathlib import Path
 
+import _hand_off  # noqa: F401 (first: the job may run in the job server)
 from _logging import start
 
 from chain.report.figures.fig1_setup import fig1_setup

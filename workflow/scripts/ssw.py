@@ -1,5 +1,6 @@
 """Secondary solitary waves behind every crossed pulse (chain.analysis.ssw.ssw_table)."""
 
+import _hand_off  # noqa: F401 (first: the job may run in the job server)
 import pandas as pd
 from _inputs import selection
 from _logging import start

@@ -18,6 +18,10 @@ from pathlib import Path
 #: The package whose files are followed.
 PACKAGE = "chain"
 
+#: Local helpers that say how a job runs, not what it computes (the job server's hand-
+#: off, chain.pipeline.job_server): not a code input, as Snakemake's own code is not.
+TRANSPORT = frozenset({"_hand_off"})
+
 
 def _imported_names(path: Path) -> list[tuple[str, list[str]]]:
     """(module, names) of each import statement of ``path``, anywhere in the file;
@@ -125,6 +129,8 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
     script, root = Path(script).resolve(), Path(package_dir).resolve()
     files: set[Path] = set()
     for module, names in _imported_names(script):
+        if module in TRANSPORT:
+            continue
         local = script.parent / f"{module}.py"
         if local.is_file():
             files.add(local)

@@ -1,0 +1,411 @@
+"""The job server: a workflow's jobs run where their imports are already paid.
+
+A job of this workflow is a fresh Python process that spends most of its time starting
+up: ``import pandas`` 0.5-0.7 s, ``scipy.optimize`` 0.9 s, ``numba`` 0.8 s,
+``matplotlib.pyplot`` 1.1 s, against a few tenths of a second of work for most steps.
+So a local run starts one server (:func:`start`, from the Snakefile's ``onstart``) that
+imports, once, every module the workflow's scripts import, then waits on a Unix socket.
+Each job is still its own Snakemake job, with its own script, inputs, outputs, log and
+exit status; its process (the *client*) hands the job over (:func:`hand_off`, the first
+import of every script) and the server forks a child that runs the same script, with
+the client's working directory, environment, standard streams and ``sys.path``. The
+child shares the server's imported modules and nothing else: each job is a separate
+process, as before, and gives the same bytes (tests/test_job_server.py and the
+workflow tests compare the two ways).
+
+The client stays for the whole job, so Snakemake sees a job end when its work ends:
+it passes SIGINT and SIGTERM on to the child and exits with the child's status. A
+child whose client dies (SIGKILL) is stopped with SIGTERM, so its atomic writers clean
+up; a server whose Snakemake dies exits (``PR_SET_PDEATHSIG`` and a check of its
+parent). With no server (a cluster job, ``HERTZCHAIN_JOB_SERVER=off``, a server that
+is not up), a job runs in its own process as it always did.
+"""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import importlib
+import os
+import pickle
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import time
+import traceback
+from pathlib import Path
+
+#: Environment variable: the server's address (set by :func:`start` for the jobs), or
+#: ``off`` to run every job in its own process.
+ADDRESS_VARIABLE = "HERTZCHAIN_JOB_SERVER"
+
+#: Set in the server's children: a job already in the server runs where it is.
+_IN_SERVER = False
+
+#: The server's log (a copy of its stdout, which a child replaces with its job's).
+_SERVER_LOG = 1
+
+#: Exit status of a child killed by a signal: the shell's convention, 128 + signal.
+_SIGNAL_BASE = 128
+
+_HEADER = struct.Struct("!Q")  # length of the pickled request
+_STATUS = struct.Struct("!q")  # the child's pid, then its exit status
+
+
+# ---- the client: a job's own process --------------------------------------------------
+
+
+def hand_off(script: str | None) -> None:
+    """Run this job's ``script`` in the workflow's job server, if one is up, and exit
+    with its status; return (the caller runs the script itself) if there is none.
+
+    Parameters
+    ----------
+    script : str or None
+        The file the job's interpreter is running: Snakemake's copy of the workflow
+        script with its preamble (``__real_file__``); None, run here.
+    """
+    address = os.environ.get(ADDRESS_VARIABLE, "off")
+    if _IN_SERVER or script is None or address == "off":
+        return
+    try:
+        connection = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        connection.connect(_socket_name(address))
+        request = pickle.dumps(
+            {"script": script, "cwd": os.getcwd(), "env": dict(os.environ), "path": sys.path}
+        )
+        socket.send_fds(connection, [_HEADER.pack(len(request))], [0, 1, 2])
+        connection.sendall(request)
+        child = _receive(connection)
+    except OSError:
+        return  # no server (not up, gone): the job runs here
+    if child is None:
+        return  # the server went away before it started the job
+    raise SystemExit(_wait_for(connection, child))
+
+
+def _wait_for(connection: socket.socket, child: int) -> int:
+    """The exit status of the server's ``child``; SIGINT and SIGTERM sent to this
+    process are passed on to it (it takes the first and ignores repeats, so a signal
+    sent to the whole process group, which reaches it directly too, acts once)."""
+
+    def pass_on(signum, frame):
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(child, signum)
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, pass_on)
+    status = _receive(connection)
+    # No status: the child died without reporting (SIGKILL); a job that fails.
+    return _SIGNAL_BASE + signal.SIGKILL if status is None else status
+
+
+def _receive(connection: socket.socket) -> int | None:
+    """One integer from the other end, or None if it closed first."""
+    data = b""
+    while len(data) < _STATUS.size:
+        try:
+            chunk = connection.recv(_STATUS.size - len(data))
+        except InterruptedError:  # pragma: no cover (PEP 475 retries)
+            continue
+        if not chunk:
+            return None
+        data += chunk
+    return _STATUS.unpack(data)[0]
+
+
+def _socket_name(address: str) -> str:
+    """The socket of ``address``: Linux's abstract namespace (no file, no path-length
+    limit, gone with the server)."""
+    return "\0" + address
+
+
+# ---- the server -----------------------------------------------------------------------
+
+
+def start(scripts: str | os.PathLike, log: str | os.PathLike) -> subprocess.Popen | None:
+    """Start the job server for the jobs of this process (a local Snakemake run) and
+    tell them where it is (:data:`ADDRESS_VARIABLE`). Returns at once: the server
+    imports while the first jobs are being scheduled, and a job that connects early
+    waits for it.
+
+    Parameters
+    ----------
+    scripts : path
+        The workflow's scripts folder: the server imports what they import.
+    log : path
+        The server's own log (its imports, the jobs it started).
+
+    Returns
+    -------
+    subprocess.Popen or None
+        The server's process; None if ``HERTZCHAIN_JOB_SERVER=off`` or not on Linux
+        (the jobs run in their own processes).
+    """
+    if os.environ.get(ADDRESS_VARIABLE) == "off" or not sys.platform.startswith("linux"):
+        return None
+    address = f"hertzchain-{os.getpid()}-{os.urandom(6).hex()}"
+    Path(log).parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as stream:
+        server = subprocess.Popen(
+            [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
+            stdin=subprocess.DEVNULL,
+            stdout=stream,
+            stderr=subprocess.STDOUT,
+        )
+    os.environ[ADDRESS_VARIABLE] = address
+    return server
+
+
+def stop(server: subprocess.Popen | None) -> None:
+    """Stop the server :func:`start` started (None: nothing to do); its running
+    children, if any, finish their jobs."""
+    os.environ.pop(ADDRESS_VARIABLE, None)
+    if server is not None and server.poll() is None:
+        server.terminate()
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            server.wait(timeout=10)
+
+
+def serve(address: str, scripts: Path) -> None:
+    """The server's main loop: listen at ``address``, import what the ``scripts``
+    import, then fork a child per job until the parent (Snakemake) is gone or a
+    SIGTERM or SIGINT arrives."""
+    global _SERVER_LOG
+    _SERVER_LOG = os.dup(1)
+    parent = os.getppid()
+    _die_with_parent()
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    listener.bind(_socket_name(address))
+    listener.listen(64)  # jobs that connect while the imports run wait in the backlog
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda signum, frame: os._exit(0))
+    _preload(scripts)
+    kernels = _load_cached_kernels()
+    signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # children reap themselves
+    listener.settimeout(1.0)
+    print(f"job server: ready at {address} ({kernels} numba kernels loaded)", flush=True)
+    while os.getppid() == parent:
+        try:
+            connection, _ = listener.accept()
+        except TimeoutError:
+            continue
+        connection.settimeout(None)
+        if os.fork() == 0:
+            listener.close()
+            _run_child(connection)  # never returns
+        connection.close()
+
+
+def _die_with_parent() -> None:
+    """Have the kernel send this process SIGTERM when its parent exits (Linux)."""
+    import ctypes
+
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+
+
+def _preload(scripts: Path) -> None:
+    """Import every module a script of ``scripts`` imports at its top level (its local
+    helpers too); one that fails is left for the job to report."""
+    sys.path.insert(0, str(scripts))
+    for module in sorted(_top_level_imports(scripts)):
+        try:
+            importlib.import_module(module)
+        except Exception as error:  # the job, importing it, fails the same way
+            print(f"job server: not preloaded {module}: {error!r}", flush=True)
+    sys.path.remove(str(scripts))
+
+
+def _load_cached_kernels() -> int:
+    """Load, from numba's cache, every compiled version of every kernel of the imported
+    ``chain`` modules that this machine's cache holds for the current code; compile
+    none (a missing one is compiled by the job that needs it, as before). Each job would
+    otherwise read them from disk again (~1 s a job that integrates). Returns how many
+    were loaded."""
+    dispatcher_type = getattr(sys.modules.get("numba.core.dispatcher"), "Dispatcher", None)
+    if dispatcher_type is None:
+        return 0
+    loaded = 0
+    modules = [m for name, m in sys.modules.items() if name.split(".")[0] == "chain"]
+    for module in modules:
+        for kernel in list(vars(module).values()):
+            if isinstance(kernel, dispatcher_type):
+                loaded += _load_cached_versions(kernel)
+    return loaded
+
+
+def _load_cached_versions(kernel) -> int:
+    """Load the versions of one numba ``kernel`` that its cache index lists for this
+    code and this machine (numba's private cache API: any surprise loads nothing)."""
+    try:
+        cache = kernel._cache
+        index = cache._cache_file._load_index()
+        codegen = kernel.targetctx.codegen()
+    except Exception:
+        return 0
+    loaded = 0
+    for key in index:
+        signature = key[0]
+        if key != cache._index_key(signature, codegen):
+            continue  # another machine's or another version's
+        args, _ = _numba_signature(signature)
+        if tuple(args) in kernel.overloads:
+            continue
+        try:
+            kernel.compile(signature)  # found in the cache: loaded, not compiled
+        except Exception as error:
+            print(f"job server: {kernel.__name__} {signature}: {error!r}", flush=True)
+            continue
+        loaded += 1
+    return loaded
+
+
+def _numba_signature(signature):
+    """(argument types, return type) of a numba signature."""
+    from numba.core import sigutils
+
+    return sigutils.normalize_signature(signature)
+
+
+def _top_level_imports(scripts: Path) -> set[str]:
+    """Modules the scripts of ``scripts`` import in their top-level statements."""
+    modules: set[str] = set()
+    for path in scripts.glob("*.py"):
+        for node in ast.parse(path.read_text(), filename=str(path)).body:
+            if isinstance(node, ast.Import):
+                modules.update(alias.name for alias in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                modules.add(node.module)
+    return modules - {"_hand_off"}
+
+
+# ---- a child: one job -------------------------------------------------------------------
+
+
+def _run_child(connection: socket.socket) -> None:
+    """Take the job's request, become its process (streams, directory, environment)
+    and run its script; report the exit status and exit. Never returns. A child that
+    fails before it has sent its pid closes without a word, and the client runs the
+    job itself."""
+    global _IN_SERVER
+    _IN_SERVER = True
+    _signals_once()
+    started, status = False, 1
+    try:
+        request = _take_request(connection)
+        connection.sendall(_STATUS.pack(os.getpid()))
+        started = True
+        _stop_when_client_dies(connection)
+        begun = time.perf_counter()
+        status = _run_script(request["script"])
+        _log(
+            f"{Path(request['script']).name}: status {status}, {time.perf_counter() - begun:.2f} s"
+        )
+    finally:
+        # Nothing may interrupt the way out (the watcher's SIGTERM once the client has
+        # its status): this process must end here, not unwind into the server's loop.
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        if started:
+            with contextlib.suppress(OSError):
+                connection.sendall(_STATUS.pack(status))
+        os._exit(status)
+
+
+def _log(line: str) -> None:
+    """A line in the server's log, from a child (whose stdout is its job's)."""
+    with contextlib.suppress(OSError):
+        os.write(_SERVER_LOG, f"job server: pid {os.getpid()}: {line}\n".encode())
+
+
+def _take_request(connection: socket.socket) -> dict:
+    """Read the request and adopt the client's streams, directory, environment and
+    import path."""
+    import tempfile
+
+    header, fds, _, _ = socket.recv_fds(connection, _HEADER.size, 3)
+    (length,) = _HEADER.unpack(header)
+    data = b""
+    while len(data) < length:
+        chunk = connection.recv(length - len(data))
+        if not chunk:
+            raise ConnectionError("the client closed before its request was read")
+        data += chunk
+    request = pickle.loads(data)
+    for target, fd in enumerate(fds):
+        os.dup2(fd, target)
+        os.close(fd)
+    sys.stdin = open(0, closefd=False)
+    sys.stdout = open(1, "w", closefd=False)
+    sys.stderr = open(2, "w", closefd=False)
+    os.chdir(request["cwd"])
+    os.environ.clear()
+    os.environ.update(request["env"])
+    os.environ[ADDRESS_VARIABLE] = "off"  # the job's own subprocesses run where they are
+    tempfile.tempdir = None  # TMPDIR is the job's (a resource of the rule)
+    sys.path[:] = request["path"]
+    signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the job's own children are waited for
+    return request
+
+
+def _signals_once() -> None:
+    """SIGINT and SIGTERM act as in a job's own process (KeyboardInterrupt, and the
+    SystemExit of the scripts' handler), once: a signal sent to the process group
+    reaches the child both directly and through its client."""
+
+    def once(signum, frame):
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        if signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise SystemExit(_SIGNAL_BASE + signum)
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, once)
+
+
+def _stop_when_client_dies(connection: socket.socket) -> None:
+    """SIGTERM this child if its client goes away (killed): the job is over for
+    Snakemake, and the atomic writers clean up on SystemExit."""
+    import threading
+
+    def watch():
+        with contextlib.suppress(OSError):
+            connection.recv(1)  # the client sends nothing more: returns at its end
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def _run_script(script: str) -> int:
+    """Run ``script`` as the job's ``__main__``; its exit status, as Python's would be."""
+    import runpy
+
+    try:
+        runpy.run_path(script, run_name="__main__")
+    except SystemExit as stop:
+        code = stop.code
+        if code is None or isinstance(code, int):
+            return code or 0
+        print(code, file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        traceback.print_exc()
+        return _SIGNAL_BASE + signal.SIGINT
+    except BaseException:
+        traceback.print_exc()
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    # Through the package's module, not this __main__ copy of it: the children's
+    # hand_off must see _IN_SERVER set (else each job would hand itself off again).
+    from chain.pipeline import job_server
+
+    job_server.serve(sys.argv[1], Path(sys.argv[2]))

@@ -1,0 +1,250 @@
+"""The job server (chain.pipeline.job_server): a job handed to it runs as it would in
+its own process (same outputs, streams, directory, environment, exit status), and the
+signals a job's process gets (Ctrl-C, a batch system's SIGTERM, a crash) end the work
+as they did, leaving no temporary file; with no server the job runs where it is.
+
+Each test starts a server on a folder of small scripts written like the workflow's
+(``import _hand_off`` first) and runs them as Snakemake does: a fresh interpreter on a
+copy of the script whose preamble sets ``__real_file__``. That the workflow's own
+results do not depend on the server is the workflow tests' business: test_workflow's
+recompute runs without it, test_reproducibility's first build too.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from chain.pipeline.job_server import ADDRESS_VARIABLE
+
+ROOT = Path(__file__).resolve().parents[1]
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux sockets")
+
+#: A job like the workflow's: numpy and pandas imported after the hand-off, a result
+#: written through the atomic writer, a line on stdout and one on stderr, and what the
+#: process is (its parent, directory, an environment variable) in the output.
+COMPUTE = """
+import _hand_off  # noqa: F401
+import os
+import sys
+
+import numpy as np
+import pandas as pd
+
+from chain.atomic import write_csv_atomic
+
+values = np.random.default_rng(7).normal(size=50).cumsum()
+write_csv_atomic(pd.DataFrame({"x": values}), "out/table.csv")
+with open("out/process.txt", "w") as stream:
+    print(os.getppid(), os.getcwd(), os.environ.get("JOB_VALUE"), file=stream)
+print("to stdout")
+print("to stderr", file=sys.stderr)
+sys.exit(int(os.environ.get("JOB_STATUS", "0")))
+"""
+
+#: A job that fails with a traceback.
+FAILING = """
+import _hand_off  # noqa: F401
+
+raise ValueError("a bad input, named")
+"""
+
+#: A job that writes its pid, then waits in the middle of an atomic write until
+#: signalled; the atomic writer removes its temporary file on the way out.
+WAITING = """
+import _hand_off  # noqa: F401
+import os
+import time
+
+from chain.atomic import atomic_output
+
+with atomic_output("out/result.txt") as temporary:
+    temporary.write_text("partial")
+    with open("out/pid.txt", "w") as stream:
+        stream.write(str(os.getpid()))
+    while True:
+        time.sleep(0.05)
+"""
+
+
+@pytest.fixture
+def scripts(tmp_path) -> Path:
+    """The scripts folder: the hand-off helper and the jobs above."""
+    folder = tmp_path / "scripts"
+    folder.mkdir()
+    shutil.copy2(ROOT / "workflow" / "scripts" / "_hand_off.py", folder)
+    for name, text in {"compute": COMPUTE, "failing": FAILING, "waiting": WAITING}.items():
+        (folder / f"{name}.py").write_text(text)
+    (tmp_path / "work" / "out").mkdir(parents=True)
+    return folder
+
+
+@pytest.fixture
+def server(scripts, tmp_path):
+    """A running job server for ``scripts``; (address, process). Ready when it says so
+    (it binds before it imports, so a job never races its start)."""
+    address = f"hertzchain-test-{os.getpid()}-{os.urandom(4).hex()}"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    lines = []
+    while not (lines and lines[-1].startswith("job server: ready")):
+        lines.append(process.stdout.readline())
+        assert lines[-1], "the server ended before it was ready:\n" + "".join(lines)
+    yield address, process
+    process.terminate()
+    process.wait(timeout=30)
+
+
+def job(scripts: Path, name: str, address: str, tmp_path: Path, **env) -> list[str]:
+    """The command and environment of a job as Snakemake runs it: the script copied
+    with a preamble that sets ``__real_file__``."""
+    copy = tmp_path / "work" / f".job.{name}.py"
+    preamble = f"import sys; sys.path.extend([{str(scripts)!r}]); __real_file__ = __file__\n"
+    copy.write_text(preamble + (scripts / f"{name}.py").read_text())
+    environment = {**os.environ, ADDRESS_VARIABLE: address, **env}
+    return [sys.executable, str(copy)], environment
+
+
+def run_job(scripts, name, address, tmp_path, **env) -> subprocess.CompletedProcess:
+    command, environment = job(scripts, name, address, tmp_path, **env)
+    return subprocess.run(
+        command, cwd=tmp_path / "work", env=environment, capture_output=True, text=True
+    )
+
+
+def test_a_job_in_the_server_gives_what_its_own_process_gives(scripts, server, tmp_path):
+    """Same table bytes, streams, directory, environment and exit status; only the
+    parent differs (the server, not the job's own process)."""
+    address, process = server
+    out = tmp_path / "work" / "out"
+    results = {}
+    for where in ("off", address):
+        result = run_job(scripts, "compute", where, tmp_path, JOB_VALUE="42", JOB_STATUS="3")
+        parent, cwd, value = (out / "process.txt").read_text().split()
+        results[where] = (result, (out / "table.csv").read_bytes(), parent, cwd, value)
+    alone, served = results["off"], results[address]
+    assert served[2] == str(process.pid) and alone[2] != str(process.pid)
+    for result, table, _, cwd, value in (alone, served):
+        assert result.returncode == 3, result.stderr
+        assert (result.stdout, result.stderr) == ("to stdout\n", "to stderr\n")
+        assert cwd == str(tmp_path / "work") and value == "42"
+        assert table == alone[1]
+
+
+def test_a_failing_job_fails_with_its_traceback(scripts, server, tmp_path):
+    address, _ = server
+    result = run_job(scripts, "failing", address, tmp_path)
+    assert result.returncode == 1
+    assert "ValueError: a bad input, named" in result.stderr and "Traceback" in result.stderr
+
+
+def test_without_a_server_the_job_runs_in_its_own_process(scripts, tmp_path):
+    """An address nobody listens at (a server that is gone): the job runs here."""
+    result = run_job(scripts, "compute", "hertzchain-test-nobody", tmp_path)
+    assert result.returncode == 0, result.stderr
+    parent = (tmp_path / "work" / "out" / "process.txt").read_text().split()[0]
+    assert parent == str(os.getpid())
+
+
+def gone(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    # A zombie is gone for our purpose (the server's children are reaped by the kernel,
+    # SIGCHLD ignored, but this reads /proc in case).
+    status = Path(f"/proc/{pid}/status")
+    return status.exists() and "zombie" in status.read_text()
+
+
+def started(scripts, address, tmp_path) -> tuple[subprocess.Popen, int]:
+    """The waiting job, started in the server; (its client's process, the child's pid)
+    once the child is inside its atomic write."""
+    command, environment = job(scripts, "waiting", address, tmp_path)
+    client = subprocess.Popen(
+        command, cwd=tmp_path / "work", env=environment, preexec_fn=_default_signals
+    )
+    pid_file = tmp_path / "work" / "out" / "pid.txt"
+    deadline = time.monotonic() + 120
+    while not (pid_file.exists() and pid_file.read_text()):
+        assert client.poll() is None, "the job ended before it started waiting"
+        assert time.monotonic() < deadline, "the job did not start"
+        time.sleep(0.02)
+    return client, int(pid_file.read_text())
+
+
+def _default_signals() -> None:
+    # A background shell starts pytest with SIGINT ignored, and an ignored signal stays
+    # ignored across exec (tests/test_reproducibility.py does the same).
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, signal.SIG_DFL)
+
+
+def wait_gone(pid: int) -> None:
+    deadline = time.monotonic() + 60
+    while not gone(pid):
+        assert time.monotonic() < deadline, f"process {pid} still running"
+        time.sleep(0.02)
+
+
+@pytest.mark.parametrize(
+    ("signum", "status"),
+    [(signal.SIGTERM, 128 + signal.SIGTERM), (signal.SIGINT, 128 + signal.SIGINT)],
+    ids=["SIGTERM", "SIGINT"],
+)
+def test_a_signal_to_the_jobs_process_stops_the_job_cleanly(
+    scripts, server, tmp_path, signum, status
+):
+    """SIGTERM (a batch system's cancel) or SIGINT to the job's process: the job stops
+    with the status of a job stopped so, and its temporary file is gone."""
+    address, process = server
+    client, child = started(scripts, address, tmp_path)
+    assert child != client.pid
+    client.send_signal(signum)
+    assert client.wait(timeout=60) == status
+    wait_gone(child)
+    assert sorted(p.name for p in (tmp_path / "work" / "out").iterdir()) == ["pid.txt"]
+    assert process.poll() is None  # the server serves on
+
+
+def test_a_killed_jobs_process_takes_its_work_with_it(scripts, server, tmp_path):
+    """SIGKILL to the job's process (the OOM killer): its child in the server is stopped
+    and cleans up; nothing runs on for a job Snakemake thinks is over."""
+    address, _ = server
+    client, child = started(scripts, address, tmp_path)
+    client.kill()
+    client.wait(timeout=60)
+    wait_gone(child)
+    assert sorted(p.name for p in (tmp_path / "work" / "out").iterdir()) == ["pid.txt"]
+
+
+def test_the_server_ends_with_the_process_that_started_it(scripts, tmp_path):
+    """Snakemake killed alone (its process group spared): the server does not linger."""
+    address = f"hertzchain-test-{os.getpid()}-orphan"
+    starter = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import subprocess, sys; p = subprocess.Popen([sys.executable, '-m', "
+            f"'chain.pipeline.job_server', {address!r}, {str(scripts)!r}], "
+            "stdout=subprocess.PIPE, text=True); print(p.pid, flush=True); "
+            "p.stdout.readline()",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert starter.returncode == 0, starter.stderr
+    wait_gone(int(starter.stdout.split()[0]))

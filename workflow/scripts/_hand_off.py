@@ -1,0 +1,12 @@
+"""First import of every script: hand the job to the workflow's job server, if one is
+up, before the script imports anything heavy (chain.pipeline.job_server).
+
+Importing this module runs the job in the server and exits with its status; without a
+server (a cluster job, ``HERTZCHAIN_JOB_SERVER=off``), or in the server, it does
+nothing and the script goes on here.
+"""
+
+import __main__
+from chain.pipeline.job_server import hand_off
+
+hand_off(getattr(__main__, "__real_file__", None))
