@@ -274,7 +274,11 @@ def _top_level_imports(scripts: Path) -> set[str]:
     """Modules the scripts of ``scripts`` import in their top-level statements."""
     modules: set[str] = set()
     for path in scripts.glob("*.py"):
-        for node in ast.parse(path.read_text(), filename=str(path)).body:
+        try:
+            body = ast.parse(path.read_text(), filename=str(path)).body
+        except (SyntaxError, ValueError, OSError):
+            continue  # its job reports it, run as it would be without a server
+        for node in body:
             if isinstance(node, ast.Import):
                 modules.update(alias.name for alias in node.names)
             elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
