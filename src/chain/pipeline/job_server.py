@@ -172,7 +172,15 @@ def stop(server: subprocess.Popen | None) -> None:
 def serve(address: str, scripts: Path) -> None:
     """The server's main loop: listen at ``address``, import what the ``scripts``
     import, then fork a child per job until the parent (Snakemake) is gone or a
-    SIGTERM or SIGINT arrives."""
+    SIGTERM or SIGINT arrives (then it exits at once).
+
+    Parameters
+    ----------
+    address : str
+        The socket's name in Linux's abstract namespace (:data:`ADDRESS_VARIABLE`).
+    scripts : Path
+        The workflow's scripts folder.
+    """
     global _SERVER_LOG
     _SERVER_LOG = os.dup(1)
     parent = os.getppid()
