@@ -4,6 +4,8 @@ import logging
 import signal
 import sys
 
+from chain.pipeline.job_server import stop_once
+
 
 def start(snakemake) -> logging.Logger:
     """Redirect stderr and the root logger to ``snakemake.log[0]``; return a logger.
@@ -13,7 +15,7 @@ def start(snakemake) -> logging.Logger:
     temporary file: the atomic writers delete theirs on the way out. SIGINT already
     arrives as ``KeyboardInterrupt``.
     """
-    signal.signal(signal.SIGTERM, _terminate)
+    signal.signal(signal.SIGTERM, stop_once)
     stream = open(snakemake.log[0], "w", buffering=1)  # lives as long as the job
     sys.stderr = stream
     logging.basicConfig(
@@ -43,12 +45,3 @@ def _use_job_threads(threads: int | None) -> None:
     numba = sys.modules.get("numba")
     if numba is not None and threads:
         numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
-
-
-def _terminate(signum, frame):
-    # Once: a job run by the job server (chain.pipeline.job_server) gets a signal sent
-    # to the process group both directly and from its client; a second SystemExit
-    # would cut the atomic writers' clean-up short.
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    raise SystemExit(128 + signum)

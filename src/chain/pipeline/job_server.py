@@ -365,20 +365,32 @@ def _take_request(connection: socket.socket) -> dict:
     return request
 
 
+def stop_once(signum: int, frame) -> None:
+    """Signal handler: end the job as SIGINT (KeyboardInterrupt) or SIGTERM (SystemExit
+    with status 128 + signal) do, once; later SIGINT and SIGTERM are ignored, so that a
+    signal that arrives twice (sent to the process group, it reaches a job in the server
+    both directly and through its client) cannot cut the atomic writers' clean-up short.
+    The scripts' SIGTERM handler too (workflow/scripts/_logging.py).
+
+    Parameters
+    ----------
+    signum : int
+        The signal's number.
+    frame : frame or None
+        The interrupted frame (unused).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise SystemExit(_SIGNAL_BASE + signum)
+
+
 def _signals_once() -> None:
-    """SIGINT and SIGTERM act as in a job's own process (KeyboardInterrupt, and the
-    SystemExit of the scripts' handler), once: a signal sent to the process group
-    reaches the child both directly and through its client."""
-
-    def once(signum, frame):
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        if signum == signal.SIGINT:
-            raise KeyboardInterrupt
-        raise SystemExit(_SIGNAL_BASE + signum)
-
+    """SIGINT and SIGTERM act in a child as in a job's own process, once
+    (:func:`stop_once`)."""
     for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, once)
+        signal.signal(signum, stop_once)
 
 
 def _stop_when_client_dies(connection: socket.socket) -> None:
