@@ -222,22 +222,25 @@ def test_skipping_beads_at_rest_gives_the_reference_bits(name, monkeypatch):
 _SIGNATURES_OF_BOTH_PATHS = """
 import json
 from chain.physics.builders import uniform_chain
-from chain.physics.kernels import _integrate_part
+from chain.physics.kernels import _integrate_part, _record
 from chain.physics.simulation import simulate
 
 simulate(uniform_chain(4), [0.1], [0.1], duration=1e-5)
 whole = sorted(map(str, _integrate_part.signatures))
+records = sorted(map(str, _record.overloads))
 # A launch from one end only: the far beads are at rest and skipped (at_rest).
 simulate(uniform_chain(400), [0.5], [0.0], duration=2e-4)
-print(json.dumps([whole, sorted(map(str, _integrate_part.signatures))]))
+print(json.dumps([whole, sorted(map(str, _integrate_part.signatures)), records]))
 """
 
 
 def test_a_long_chain_runs_the_kernel_a_short_chain_compiled(tmp_path):
     """numba compiles the step loop (kernels._integrate_part) once per kind of model:
-    the whole-chain entry (_integrate_one) calls it with int64 arguments, as
-    chain.physics.at_rest does from Python, never with literal constants, for which
-    numba would compile the whole loop again (~13 s of a cold run, per kind). Compiled
+    the whole chain (_integrate_one) and chain.physics.at_rest call it from Python with
+    the same types, never with literal constants, for which numba would compile the
+    whole loop again (~13 s of a cold run, per kind); and the loop records every sample,
+    the first one included, through one compiled _record (a literal 0 compiled it
+    twice). Compiled
     cold, in a fresh interpreter (~20 s): with the kernels in numba's cache the callee's
     signatures are not recorded, and the test would compare nothing."""
     import json
@@ -254,7 +257,8 @@ def test_a_long_chain_runs_the_kernel_a_short_chain_compiled(tmp_path):
         check=False,
     )
     assert done.returncode == 0, done.stderr[-3000:]
-    whole, after_at_rest = json.loads(done.stdout.splitlines()[-1])
-    assert len(whole) == 1, whole  # the whole-chain entry compiled the loop once
+    whole, after_at_rest, records = json.loads(done.stdout.splitlines()[-1])
+    assert len(whole) == 1, whole  # the whole chain compiled the loop once
     assert after_at_rest == whole
     assert "Literal" not in whole[0], whole
+    assert len(records) == 1, records
