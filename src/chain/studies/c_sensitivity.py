@@ -117,7 +117,9 @@ def pair_pulses(traces: Mapping[int, pd.DataFrame], pairs, estimators) -> pd.Dat
     return pd.concat(tables, ignore_index=True)
 
 
-def c_sensitivity_table(traces: Mapping[float, Mapping[int, pd.DataFrame]], plan: Mapping):
+def c_sensitivity_table(
+    traces: Mapping[float, Mapping[int, pd.DataFrame]], plan: Mapping, pulses_of=None
+):
     """C and the free exponent for each choice (rows of ``c_sensitivity.csv``).
 
     Parameters
@@ -126,6 +128,10 @@ def c_sensitivity_table(traces: Mapping[float, Mapping[int, pd.DataFrame]], plan
         eta (s) -> {N -> simulated trace table with every sensor bead of the plan}.
     plan : mapping
         :func:`sensitivity_plan`.
+    pulses_of : callable, optional
+        ``pulses_of(eta_s, pairs, estimators)`` -> :func:`pair_pulses` rows of the
+        traces at that eta (s) and those sensor pairs, with (at least) those
+        estimators; by default computed here, as needed.
 
     Returns
     -------
@@ -138,16 +144,21 @@ def c_sensitivity_table(traces: Mapping[float, Mapping[int, pd.DataFrame]], plan
     main, eta_paper = plan["main_estimator"], plan["eta_s"][1]
     n_speeds = len(plan["speeds_m_s"])
     low, high = list(range(n_speeds // 2)), list(range(n_speeds // 2, n_speeds))
-    base = pair_pulses(traces[eta_paper], chains, plan["estimators"])
+    if pulses_of is None:
+
+        def pulses_of(eta, pairs, estimators):
+            return pair_pulses(traces[eta], pairs, estimators)
+
+    base = pulses_of(eta_paper, chains, plan["estimators"])
     cases = [
         ("estimator", e, _fits(base, e), e, eta_paper, chains, "all") for e in plan["estimators"]
     ]
     for eta in plan["eta_s"]:
-        pulses = base if eta == eta_paper else pair_pulses(traces[eta], chains, [main])
+        pulses = base if eta == eta_paper else pulses_of(eta, chains, [main])
         cases.append(("eta_us", f"{eta * 1e6:.3g}", _fits(pulses, main), main, eta, chains, "all"))
     for shift in [0, *plan["shifts"]]:
         pairs = shifted_pairs(chains, shift)
-        pulses = base if shift == 0 else pair_pulses(traces[eta_paper], pairs, [main])
+        pulses = base if shift == 0 else pulses_of(eta_paper, pairs, [main])
         value = f"shift {shift:+d} beads"
         cases.append(("sensors", value, _fits(pulses, main), main, eta_paper, pairs, "all"))
     for name, subset in (("all", None), ("low half", low), ("high half", high)):
@@ -209,8 +220,21 @@ def c_sensitivity_every_estimator(
         Columns :data:`C_SENSITIVITY_COLUMNS`, then ``main_estimator``: each
         estimator's table after the other.
     """
+    # Each (eta, sensor pairs) read once with every estimator, for every headline
+    # estimator: an estimator's pulse rows do not depend on the others read with it
+    # (chain.analysis.pulses.measure_pulse), and the fits keep one estimator's rows.
+    read = {}
+
+    def pulses_of(eta, pairs, _estimators):
+        key = (eta, tuple(pairs.items()))
+        if key not in read:
+            read[key] = pair_pulses(traces[eta], pairs, plan["estimators"])
+        return read[key]
+
     tables = [
-        c_sensitivity_table(traces, {**plan, "main_estimator": e}).assign(main_estimator=e)
+        c_sensitivity_table(traces, {**plan, "main_estimator": e}, pulses_of).assign(
+            main_estimator=e
+        )
         for e in plan["estimators"]
     ]
     return pd.concat(tables, ignore_index=True)
