@@ -158,6 +158,74 @@ def test_without_a_server_the_job_runs_in_its_own_process(scripts, tmp_path):
     assert parent == str(os.getpid())
 
 
+#: A helper module imported by the preload, in the server: its import returns once a
+#: job waits at the server's socket (the only socket the server has then). In a job it
+#: is already imported (the job is forked from the server) or, run alone, not waited on.
+GATE = """
+import os
+import select
+import stat
+import sys
+
+if os.environ.get("GATE_IN_SERVER") == "1" and "_hand_off" not in sys.modules:
+    sockets = []
+    for name in os.listdir("/proc/self/fd"):
+        try:
+            if stat.S_ISSOCK(os.fstat(int(name)).st_mode):
+                sockets.append(int(name))
+        except OSError:
+            pass
+    print("gate: waiting for a job", flush=True)
+    select.select(sockets, [], [])
+"""
+
+#: A job that says which of the preload's modules were imported when it started: the
+#: gate (imported just before it was forked) and the module after it (not yet).
+EARLY = """
+import _hand_off  # noqa: F401
+import sys
+
+print("gate" in sys.modules, "zz_after_gate" in sys.modules)
+
+import gate  # noqa: E402,F401
+import zz_after_gate  # noqa: E402,F401
+"""
+
+
+def test_a_job_does_not_wait_for_the_whole_preload(scripts, tmp_path):
+    """The server serves a job between two of its preload's imports: a job that arrives
+    while the preload runs is forked with what is imported so far (the gate module,
+    whose import in the server ends when the job is waiting) and imports the rest
+    itself, before the server has imported the module after the gate or said it is
+    ready. No clock: the gate waits for the job, not for a time."""
+    (scripts / "gate.py").write_text(GATE)
+    (scripts / "zz_after_gate.py").write_text("")
+    (scripts / "early.py").write_text(EARLY)
+    address = f"hertzchain-test-{os.getpid()}-{os.urandom(4).hex()}"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "GATE_IN_SERVER": "1"},
+    )
+    try:
+        lines = []
+        while not (lines and lines[-1].startswith("gate: waiting")):
+            lines.append(process.stdout.readline())
+            assert lines[-1], "the server ended before its gate:\n" + "".join(lines)
+        result = run_job(scripts, "early", address, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert result.stdout.split() == ["True", "False"]
+        lines.append(process.stdout.readline())
+        while lines[-1] and not lines[-1].startswith("job server: ready"):
+            lines.append(process.stdout.readline())
+        assert lines[-1].startswith("job server: ready"), "".join(lines)
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+
+
 def gone(pid: int) -> bool:
     try:
         os.kill(pid, 0)

@@ -4,7 +4,9 @@ A job of this workflow is a fresh Python process that spends most of its time st
 up: ``import pandas`` 0.5-0.7 s, ``scipy.optimize`` 0.9 s, ``numba`` 0.8 s,
 ``matplotlib.pyplot`` 1.1 s, against a few tenths of a second of work for most steps.
 So a local run starts one server (:func:`start`, from the Snakefile's ``onstart``) that
-imports, once, every module the workflow's scripts import, then waits on a Unix socket.
+imports, once, every module the workflow's scripts import, and serves jobs on a Unix
+socket (from the start: a job that comes while it imports is served between two
+imports, and imports the rest itself).
 Each job is still its own Snakemake job, with its own script, inputs, outputs, log and
 exit status; its process (the *client*) hands the job over (:func:`hand_off`, the first
 import of every script) and the server forks a child that runs the same script, with
@@ -170,9 +172,14 @@ def stop(server: subprocess.Popen | None) -> None:
 
 
 def serve(address: str, scripts: Path) -> None:
-    """The server's main loop: listen at ``address``, import what the ``scripts``
-    import, then fork a child per job until the parent (Snakemake) is gone or a
-    SIGTERM or SIGINT arrives (then it exits at once).
+    """The server's main loop: listen at ``address``, fork a child per job until the
+    parent (Snakemake) is gone or a SIGTERM or SIGINT arrives (then it exits at once),
+    and meanwhile import what the ``scripts`` import and load numba's cached kernels.
+
+    The imports run one module at a time, between jobs: a job that arrives first is
+    forked at once, with what is imported so far, and imports the rest itself, as it
+    would in its own process. A run of a few jobs (a figure what-if) does not wait for
+    the whole preload (~3 s) before its first job; a long run soon has it all.
 
     Parameters
     ----------
@@ -187,18 +194,18 @@ def serve(address: str, scripts: Path) -> None:
     _die_with_parent()
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     listener.bind(_socket_name(address))
-    listener.listen(64)  # jobs that connect while the imports run wait in the backlog
+    listener.listen(64)
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda signum, frame: os._exit(0))
-    _preload(scripts)
-    kernels = _load_cached_kernels()
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # children reap themselves
-    listener.settimeout(1.0)
-    print(f"job server: ready at {address} ({kernels} numba kernels loaded)", flush=True)
+    steps = _preload_steps(scripts, address)
     while os.getppid() == parent:
+        listener.settimeout(0.0 if steps else 1.0)  # no wait while there is preloading
         try:
             connection, _ = listener.accept()
-        except TimeoutError:
+        except (TimeoutError, BlockingIOError):
+            if steps:
+                steps.pop(0)()
             continue
         connection.settimeout(None)
         if os.fork() == 0:
@@ -207,24 +214,36 @@ def serve(address: str, scripts: Path) -> None:
         connection.close()
 
 
+def _preload_steps(scripts: Path, address: str) -> list:
+    """The server's preload as steps to run between jobs: one import per module the
+    ``scripts`` import at their top level (their local helpers too; one that fails is
+    left for the job to report), then numba's cached kernels, then the "ready" line."""
+
+    def importing(module: str):
+        def step() -> None:
+            sys.path.insert(0, str(scripts))
+            try:
+                importlib.import_module(module)
+            except Exception as error:  # the job, importing it, fails the same way
+                print(f"job server: not preloaded {module}: {error!r}", flush=True)
+            finally:
+                sys.path.remove(str(scripts))
+
+        return step
+
+    def kernels() -> None:
+        loaded = _load_cached_kernels()
+        print(f"job server: ready at {address} ({loaded} numba kernels loaded)", flush=True)
+
+    return [*(importing(m) for m in sorted(_top_level_imports(scripts))), kernels]
+
+
 def _die_with_parent() -> None:
     """Have the kernel send this process SIGTERM when its parent exits (Linux)."""
     import ctypes
 
     with contextlib.suppress(OSError, AttributeError):
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-
-
-def _preload(scripts: Path) -> None:
-    """Import every module a script of ``scripts`` imports at its top level (its local
-    helpers too); one that fails is left for the job to report."""
-    sys.path.insert(0, str(scripts))
-    for module in sorted(_top_level_imports(scripts)):
-        try:
-            importlib.import_module(module)
-        except Exception as error:  # the job, importing it, fails the same way
-            print(f"job server: not preloaded {module}: {error!r}", flush=True)
-    sys.path.remove(str(scripts))
 
 
 def _load_cached_kernels() -> int:
