@@ -87,21 +87,31 @@ def scripts(tmp_path) -> Path:
     return folder
 
 
-@pytest.fixture
-def server(scripts, tmp_path):
-    """A running job server for ``scripts``; (address, process). Ready when it says so
-    (it binds before it imports, so a job never races its start)."""
+def start_server(scripts: Path, until: str, **env) -> tuple[str, subprocess.Popen, list]:
+    """A job server for ``scripts`` started with ``env`` added to this environment;
+    (address, process, the lines it printed) once it printed a line starting ``until``."""
     address = f"hertzchain-test-{os.getpid()}-{os.urandom(4).hex()}"
     process = subprocess.Popen(
         [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
+        env={**os.environ, **env},
     )
     lines = []
-    while not (lines and lines[-1].startswith("job server: ready")):
+    while not (lines and lines[-1].startswith(until)):
         lines.append(process.stdout.readline())
-        assert lines[-1], "the server ended before it was ready:\n" + "".join(lines)
+        if not lines[-1]:
+            process.wait(timeout=30)
+            raise AssertionError(f"the server ended before {until!r}:\n" + "".join(lines))
+    return address, process, lines
+
+
+@pytest.fixture
+def server(scripts, tmp_path):
+    """A running job server for ``scripts``; (address, process). Ready when it says so
+    (it binds before it imports, so a job never races its start)."""
+    address, process, _ = start_server(scripts, "job server: ready")
     yield address, process
     process.terminate()
     process.wait(timeout=30)
@@ -201,19 +211,8 @@ def test_a_job_does_not_wait_for_the_whole_preload(scripts, tmp_path):
     (scripts / "gate.py").write_text(GATE)
     (scripts / "zz_after_gate.py").write_text("")
     (scripts / "early.py").write_text(EARLY)
-    address = f"hertzchain-test-{os.getpid()}-{os.urandom(4).hex()}"
-    process = subprocess.Popen(
-        [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        env={**os.environ, "GATE_IN_SERVER": "1"},
-    )
+    address, process, lines = start_server(scripts, "gate: waiting", GATE_IN_SERVER="1")
     try:
-        lines = []
-        while not (lines and lines[-1].startswith("gate: waiting")):
-            lines.append(process.stdout.readline())
-            assert lines[-1], "the server ended before its gate:\n" + "".join(lines)
         result = run_job(scripts, "early", address, tmp_path)
         assert result.returncode == 0, result.stderr
         assert result.stdout.split() == ["True", "False"]
