@@ -171,8 +171,9 @@ rule ssw_track:
     log:
         f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
     cache: REUSE
-    # Before the tables: its long-chain jobs take 2 threads, and a what-if that links
-    # them from the store would otherwise wait for both cores to be free.
+    # Before the tables, which wait for it. A local run gives it one thread
+    # (profiles/default: set-threads), so that a what-if links the long chains' tracks
+    # from the store without waiting for two free cores.
     priority: 3
     conda:
         ENV

@@ -25,6 +25,7 @@ from chain.pipeline.reuse import (
     software_versions,
     unhashed_wildcards,
 )
+from chain.pipeline.run_end import cancel_pending_timers
 
 check_config(config)
 PLAN = RunPlan(config)
@@ -200,9 +201,13 @@ onstart:
         )
 
 
+# cancel_pending_timers: Snakemake's scheduler leaves a 1 s timer behind that the
+# process would wait for before exiting (chain.pipeline.run_end).
 onsuccess:
     job_server.stop(JOB_SERVER.pop("process", None))
+    cancel_pending_timers()
 
 
 onerror:
     job_server.stop(JOB_SERVER.pop("process", None))
+    cancel_pending_timers()
