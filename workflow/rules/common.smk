@@ -25,7 +25,7 @@ from chain.pipeline.reuse import (
     software_versions,
     unhashed_wildcards,
 )
-from chain.pipeline.run_end import cancel_pending_timers
+from chain.pipeline.run_end import cancel_snakemake_timers
 
 check_config(config)
 PLAN = RunPlan(config)
@@ -201,13 +201,13 @@ onstart:
         )
 
 
-# cancel_pending_timers: Snakemake's scheduler leaves a 1 s timer behind that the
+# cancel_snakemake_timers: Snakemake's scheduler leaves a 1 s timer behind that the
 # process would wait for before exiting (chain.pipeline.run_end).
 onsuccess:
     job_server.stop(JOB_SERVER.pop("process", None))
-    cancel_pending_timers()
+    cancel_snakemake_timers()
 
 
 onerror:
     job_server.stop(JOB_SERVER.pop("process", None))
-    cancel_pending_timers()
+    cancel_snakemake_timers()

@@ -13,18 +13,30 @@ from __future__ import annotations
 
 import threading
 
+#: Whose timers are cancelled: Snakemake's (its scheduler's wake-ups), not those of
+#: whatever else runs in the process (a notebook driving Snakemake's API).
+SNAKEMAKE_PACKAGE = "snakemake"
 
-def cancel_pending_timers() -> int:
-    """Cancel every ``threading.Timer`` of this process that has not fired yet, so that
-    the process exits at once; call it at the very end of a run (the Snakefile's
-    ``onsuccess`` and ``onerror``).
+
+def cancel_snakemake_timers() -> int:
+    """Cancel every ``threading.Timer`` that Snakemake's code started in this process
+    and that has not fired yet, so that the process exits at once; call it at the very
+    end of a run (the Snakefile's ``onsuccess`` and ``onerror``). Timers of other code
+    are left alone.
 
     Returns
     -------
     int
         How many timers were cancelled.
     """
-    timers = [t for t in threading.enumerate() if isinstance(t, threading.Timer)]
-    for timer in timers:
-        timer.cancel()
-    return len(timers)
+    cancelled = 0
+    for thread in threading.enumerate():
+        if isinstance(thread, threading.Timer) and _started_by_snakemake(thread):
+            thread.cancel()
+            cancelled += 1
+    return cancelled
+
+
+def _started_by_snakemake(timer: threading.Timer) -> bool:
+    module = getattr(timer.function, "__module__", None) or ""
+    return module == SNAKEMAKE_PACKAGE or module.startswith(f"{SNAKEMAKE_PACKAGE}.")
