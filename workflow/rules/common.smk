@@ -15,7 +15,7 @@ from chain.pipeline.datasets import (
     bad_channel_policy,
     check_experiment_datasets,
 )
-from chain.pipeline.deps import script_sources
+from chain.pipeline.deps import remember_imports, save_imports, script_sources
 from chain.pipeline import job_server
 from chain.pipeline.plan import RunPlan
 from chain.pipeline.provenance import run_provenance
@@ -84,6 +84,11 @@ BENCH = f"{OUT}/benchmarks"
 # package the jobs import (a checkout's src/chain, or PYTHONPATH's copy); not found
 # with `import chain`: the name would shadow a Snakemake global.
 PACKAGE_DIR = Path(importlib.util.find_spec("chain").origin).parent
+# The import statements read by an earlier command, by file version (the Snakefile
+# saves them after the last rule): every command parses the workflow, a file is read
+# again only when it changed.
+IMPORTS_STORE = Path(".snakemake") / "hertzchain" / "imports.json"
+remember_imports(IMPORTS_STORE)
 
 
 def code(script):

@@ -33,6 +33,34 @@ def plan_shots(settings: VirtualExperiment) -> pd.DataFrame:
     return _plan(settings, np.random.default_rng(settings.seed))
 
 
+def collision_speeds(settings: VirtualExperiment) -> tuple[np.ndarray, np.ndarray]:
+    """True impact speeds of the left and right strikers of the collision shots, m/s,
+    shape (amplitudes, collision shots): the plan's (:func:`plan_shots`), drawn alone
+    (they are its first draws), for a check that needs no more of it.
+
+    Parameters
+    ----------
+    settings : VirtualExperiment
+        The apparatus and the shot plan.
+    """
+    shape = (settings.nominal_speeds.size, settings.collision_shots, 3)
+    return _collision_speeds(settings, np.random.default_rng(settings.seed).standard_normal(shape))
+
+
+def _collision_speeds(settings: VirtualExperiment, draws: np.ndarray):
+    """(left, right) speeds, m/s, from the collision draws (amplitude, shot, 3)."""
+    nominal = settings.nominal_speeds[:, None]
+    left = _speed(nominal, draws[..., 0], settings.speed_mismatch)
+    right = _speed(nominal, draws[..., 1], settings.speed_mismatch)
+    return left, right * (1.0 + settings.right_speed_offset)
+
+
+def _speed(nominal, draw, spread):
+    """A striker's true speed, m/s: a few-percent mismatch never makes it negative;
+    the floor is a guard only."""
+    return nominal * np.maximum(1.0 + spread * draw, 0.05)
+
+
 def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame:
     speeds = settings.nominal_speeds
     heights = (
@@ -50,21 +78,17 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
     reference_draws = rng.standard_normal((n_amp, n_ref))
     reference_phase = rng.uniform(size=(n_amp, n_ref))
 
-    def speed(nominal, draw, spread=sigma):
-        # A few-percent mismatch never makes a speed negative; the floor is a guard only.
-        return nominal * max(1.0 + spread * draw, 0.05)
-
+    left, right = _collision_speeds(settings, collision_draws)
     rows = []
     for a in range(n_amp):
         for c in range(n_col):
-            left_draw, right_draw, delay_draw = collision_draws[a, c]
             rows.append(
                 (
                     "collision",
                     a,
-                    speed(speeds[a], left_draw),
-                    speed(speeds[a], right_draw) * (1.0 + settings.right_speed_offset),
-                    settings.right_delay_s + settings.timing_jitter_s * delay_draw,
+                    left[a, c],
+                    right[a, c],
+                    settings.right_delay_s + settings.timing_jitter_s * collision_draws[a, c, 2],
                     collision_phase[a, c],
                 )
             )
@@ -73,7 +97,7 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
                 (
                     "reference",
                     a,
-                    speed(speeds[a], reference_draws[a, r], sigma_ref),
+                    _speed(speeds[a], reference_draws[a, r], sigma_ref),
                     0.0,
                     0.0,
                     reference_phase[a, r],

@@ -97,9 +97,12 @@ def installed_distributions() -> dict[str, str]:
     ``import`` finds it)."""
     found: dict[str, str] = {}
     for distribution in metadata.distributions():
-        name = distribution.metadata["Name"]
+        # Each .metadata parses the file anew: once per distribution, not twice (half
+        # of the ~0.13 s this took in every command's parse).
+        fields = distribution.metadata
+        name = fields["Name"]
         if name:  # a broken install has no name; it is no package of ours
-            found.setdefault(normalized_name(name), distribution.version)
+            found.setdefault(normalized_name(name), fields["Version"])
     return dict(sorted(found.items()))
 
 
