@@ -157,10 +157,13 @@ rule ssw_spacetime:
     log:
         f"{LOGS}/figures/ssw_spacetime.log",
     cache: REUSE
+    # The longest figure: started as soon as its inputs exist, not after the others.
+    priority: 1
     conda:
         ENV
     # PDF and PNG drawn at once (chain.report.figures.style.save_figure): the save
     # 5.0 s against 7.3 s, most of it the field's ~3 million cells, drawn per file.
+    # Two threads on a cluster; a local run schedules it on one (profiles/default).
     threads: 2
     params:
         model=SPACETIME_MODEL,

@@ -22,5 +22,8 @@ long_fields = {
 fig = fig_ssw_spacetime(
     fields, pd.read_csv(snakemake.input.track), snakemake.params.model, long_fields
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""), processes=snakemake.threads)
+# The PNG drawn in a forked process beside the PDF, whatever the threads Snakemake
+# scheduled the job with: a local run schedules it on one core so that it does not
+# wait for two free ones (profiles/default); the fork lives for the save (~5 s).
+save_figure(fig, Path(snakemake.output.pdf).with_suffix(""), processes=2)
 log.info("done")
