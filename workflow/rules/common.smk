@@ -86,8 +86,8 @@ BENCH = f"{OUT}/benchmarks"
 PACKAGE_DIR = Path(importlib.util.find_spec("chain").origin).parent
 # The import statements read by an earlier command, by file version (the Snakefile
 # saves them after the last rule): every command parses the workflow, a file is read
-# again only when it changed.
-IMPORTS_STORE = Path(".snakemake") / "hertzchain" / "imports.json"
+# again only when it changed. Kept beside the dataset check's verdicts.
+IMPORTS_STORE = DATASET_CHECK_CACHE.parent / "imports.json"
 remember_imports(IMPORTS_STORE)
 
 
