@@ -35,6 +35,7 @@ import math
 import numba
 import numpy as np
 
+from chain.physics import compile_once
 from chain.physics.slopes import _hertz_force, _slopes, _wall_energy, _wall_terms
 
 #: Status codes written by the kernels.
@@ -237,9 +238,10 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     literal argument would compile it again)."""
     links = (links, np.arange(links.shape[0]))
     particles = (particles, np.arange(particles.shape[0]))
-    status, step, refined, _, _, _ = _integrate_part(
-        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1
-    )
+    status, step, refined, _, _, _ = compile_once.call(
+        _integrate_part,
+        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1,
+    )  # fmt: skip
     return status, step, refined
 
 

@@ -1,0 +1,68 @@
+"""Each version of a numba kernel compiled by one process at a time.
+
+numba compiles a kernel once per kind of model (its argument types; ~15-20 s of CPU
+for the step loop) and keeps the result in its cache, but two processes that need
+the same version while the cache lacks it both compile it. A fresh clone's paper run
+did: its second damped-chain job started while the first was still compiling, and
+compiled the damped kernel again (17 s of one of the two cores). :func:`call` takes a
+lock per version first: the second process waits for the first, then loads the
+first's result from numba's cache. The compiled code is the same either way.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import hashlib
+import os
+
+#: Byte ranges of a kernel's lock file, one per version (argument types), hashed.
+_RANGES = 1 << 30
+
+
+def call(kernel, *args):
+    """``kernel(*args)``, its version for these argument types compiled (or loaded from
+    numba's cache) under a lock that other processes take too.
+
+    Parameters
+    ----------
+    kernel : numba dispatcher
+        A ``numba.njit(cache=True)`` function; without a cache there is nothing to
+        share and no lock is taken. Any other callable is called as it is.
+    *args
+        Its arguments, as numba types them for a call (Python ints as int64).
+
+    Returns
+    -------
+    What ``kernel(*args)`` returns.
+    """
+    if not hasattr(kernel, "overloads"):  # not a numba dispatcher (a test's stand-in)
+        return kernel(*args)
+    signature = tuple(kernel.typeof_pyval(arg) for arg in args)
+    if signature not in kernel.overloads:
+        with _version_lock(kernel, signature):
+            kernel.compile(signature)  # the call below would compile it, unlocked
+    return kernel(*args)
+
+
+@contextlib.contextmanager
+def _version_lock(kernel, signature):
+    """An exclusive POSIX lock on one byte of ``<cache folder>/<kernel>.compile.lock``,
+    at an offset given by the version's types; nothing when the kernel has no cache
+    or its folder cannot be written (then processes may compile the same version, as
+    numba does by default). The kernel releases it if the process dies. (POSIX locks
+    belong to the process: its own threads do not wait here, but on numba's lock.)"""
+    folder = getattr(kernel._cache, "cache_path", None)  # None: numba's NullCache
+    name = f"{kernel.py_func.__module__}.{kernel.__name__}.compile.lock"
+    try:
+        descriptor = os.open(os.path.join(folder, name), os.O_RDWR | os.O_CREAT, 0o644)
+    except (TypeError, OSError):
+        yield
+        return
+    digest = hashlib.sha256(str(signature).encode()).digest()
+    offset = int.from_bytes(digest[:8], "big") % _RANGES
+    try:
+        fcntl.lockf(descriptor, fcntl.LOCK_EX, 1, offset)
+        yield
+    finally:
+        os.close(descriptor)  # releases the lock

@@ -1,0 +1,73 @@
+"""A kernel version is compiled by one process at a time (chain.physics.compile_once):
+a second process that needs it waits, then loads the first one's from numba's cache.
+Shown on a small kernel (a step loop would cost ~15 s per compile)."""
+
+from __future__ import annotations
+
+import importlib
+import os
+import subprocess
+import sys
+import textwrap
+
+from chain.physics import compile_once
+
+KERNEL = """\
+import numba
+
+
+@numba.njit(cache=True)
+def twice(x):
+    return 2.0 * x
+"""
+
+#: The second process: say it is about to call, call, report numba's cache counts.
+SECOND = """\
+import toy_kernel as toy
+from chain.physics import compile_once
+print("calling", flush=True)
+result = compile_once.call(toy.twice, 1.5)
+stats = toy.twice.stats
+print(result, sum(stats.cache_hits.values()), sum(stats.cache_misses.values()), flush=True)
+"""
+
+
+def test_a_second_process_loads_the_version_the_first_compiled(tmp_path, monkeypatch):
+    """This process holds the version's lock while the second one starts its call,
+    compiles the version only then, and releases it: the second one waited and loaded
+    that version from the cache (one hit, no miss) instead of compiling it as well.
+    (Without the lock it would have compiled at once: a miss.) No clock: each side
+    waits for a line or a lock."""
+    (tmp_path / "toy_kernel.py").write_text(KERNEL)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "toy_kernel", raising=False)
+    toy = importlib.import_module("toy_kernel")
+    signature = (toy.twice.typeof_pyval(1.5),)
+    script = tmp_path / "second.py"
+    script.write_text(textwrap.dedent(SECOND))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    with compile_once._version_lock(toy.twice, signature):
+        second = subprocess.Popen(
+            [sys.executable, str(script)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        assert second.stdout.readline().strip() == "calling", second.stderr.read()
+        toy.twice.compile(signature)  # saved to the cache while the second one waits
+    out, err = second.communicate(timeout=600)
+    assert second.returncode == 0, err
+    assert out.split() == ["3.0", "1", "0"], out
+
+
+def test_a_kernel_without_cache_is_called_without_a_lock():
+    """A kernel numba does not cache has no folder to lock in: the call just runs."""
+    import numba
+
+    @numba.njit
+    def add(a, b):
+        return a + b
+
+    assert compile_once.call(add, 2, 3) == 5
+    assert len(add.overloads) == 1
