@@ -62,7 +62,10 @@ def _version_lock(kernel, signature):
     digest = hashlib.sha256(str(signature).encode()).digest()
     offset = int.from_bytes(digest[:8], "big") % _RANGES
     try:
-        fcntl.lockf(descriptor, fcntl.LOCK_EX, 1, offset)
+        try:
+            fcntl.lockf(descriptor, fcntl.LOCK_EX, 1, offset)
+        except OSError:  # a file system without POSIX locks (ENOLCK): compile unlocked
+            pass
         yield
     finally:
         os.close(descriptor)  # releases the lock
