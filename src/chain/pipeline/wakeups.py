@@ -4,10 +4,11 @@ Snakemake 9 (read in 9.27) ends each pass of its scheduling loop in which jobs w
 ready by starting a ``threading.Timer`` that wakes the loop after the job rate
 limiter's timespan (``--max-jobs-per-timespan``, 100/1s by default). The pass such a
 timer wakes starts another timer, and every job that starts or ends adds a pass, so
-the timers multiply: a local run of the tiny test config (53 jobs) made 1816 passes,
-each re-reading the size of every ready job's inputs (~45 files: the code inputs) and
-solving the job selection again, ~7 s of Snakemake's CPU in a 70 s run on 2 cores;
-with 10 000 jobs Snakemake runs out of threads (snakemake issue #3804).
+the timers multiply: a local run of the tiny test config (53 jobs, 65 s on 2 cores)
+made 1687 passes, each re-reading the size of every ready job's inputs (~45 files: the
+code inputs) and solving the job selection again, and Snakemake used 10.3 s of CPU
+(106 passes and 4.5 s with one pending wake-up); with 10 000 jobs Snakemake runs out
+of threads (snakemake issue #3804).
 :func:`coalesce_wakeups` keeps one pending wake-up per scheduler: a pass that finds
 one on its way starts none. While jobs wait, a pass still comes at least once per
 timespan, which is all the rate limiter needs; the job selection is unchanged.
