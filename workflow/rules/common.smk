@@ -213,7 +213,8 @@ onstart:
 
 
 # cancel_snakemake_timers: Snakemake's scheduler leaves a 1 s timer behind that the
-# process would wait for before exiting (chain.pipeline.run_end).
+# process would wait for before exiting (chain.pipeline.run_end); with the wake-ups
+# coalesced above they are daemon threads, and this is the fallback.
 onsuccess:
     job_server.stop(JOB_SERVER.pop("process", None))
     cancel_snakemake_timers()

@@ -6,7 +6,9 @@ with a ``threading.Timer``, which is not a daemon thread. Python waits for such 
 before the process exits, so a run that waited for a job ended up to a second after
 its last job (measured 1.0-1.5 s from Snakemake's "Complete log" line to its exit: a
 what-if, a test's Snakemake call). The timers only wake a scheduler that has stopped
-by the time the workflow's ``onsuccess`` or ``onerror`` runs.
+by the time the workflow's ``onsuccess`` or ``onerror`` runs. The workflow replaces
+those timers by a single daemon one (:mod:`chain.pipeline.wakeups`); this stays for a
+Snakemake whose scheduler that patch does not recognise.
 """
 
 from __future__ import annotations
