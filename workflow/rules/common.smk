@@ -115,6 +115,36 @@ BAD_CHANNELS = bad_channel_policy(config)
 SELECTION = [f"{OUT}/experiment/selection.csv"] if EXPERIMENT_PARTS else []
 
 
+# ---- the job server (chain.pipeline.job_server) ------------------------------------
+# A local run's jobs run in children of one process that imported their libraries once
+# (pandas, scipy, numba, matplotlib: 1.5-2.5 s a job otherwise). Each job keeps its own
+# process, script, log and status, and the same bytes. Not on a cluster (each job on
+# its node, as before), nor with HERTZCHAIN_JOB_SERVER=off. Started here, once the
+# config and datasets passed their checks, not in `onstart`: it imports on the other
+# core while Snakemake reads the rules, builds the DAG and links stored results (~2 s
+# of one core in a what-if). The jobs learn its address in `onstart`, where the run is
+# known to be local; a cluster run stops it there. Not for a dry run; a command that
+# runs no job (--lint, --report) ends it with its own exit.
+def start_job_server():
+    return job_server.start(
+        Path(workflow.basedir) / "workflow" / "scripts", ".snakemake/job_server.log"
+    )
+
+
+JOB_SERVER = {}
+if workflow.is_main_process and not getattr(workflow.output_settings, "dryrun", True):
+    JOB_SERVER["server"] = start_job_server()
+
+
+onstart:
+    if workflow.local_exec and workflow.is_main_process:
+        if "server" not in JOB_SERVER:  # Snakemake's API without output settings
+            JOB_SERVER["server"] = start_job_server()
+        job_server.publish(JOB_SERVER["server"])
+    else:
+        job_server.stop(JOB_SERVER.pop("server", None))
+
+
 def trace_file(source, model, n):
     return f"{OUT}/{source}/{model}_N{n}_traces.csv"
 
@@ -192,34 +222,19 @@ VIRTUAL_EXPERIMENT_JOB = {"mem_mb": 1000, "runtime": 30}
 ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
 
 
-# ---- the job server (chain.pipeline.job_server) ------------------------------------
-# A local run's jobs run in children of one process that imported their libraries once
-# (pandas, scipy, numba, matplotlib: 1.5-2.5 s a job otherwise). Each job keeps its own
-# process, script, log and status, and the same bytes. Not on a cluster (each job on
-# its node, as before), nor with HERTZCHAIN_JOB_SERVER=off.
-JOB_SERVER = {}
-
 # One pending wake-up of Snakemake's scheduler at a time, not one more per job event
 # (chain.pipeline.wakeups: Snakemake's CPU in the tiny run's 53 jobs 10.3 -> 4.5 s).
 coalesce_wakeups(JobScheduler)
-
-
-onstart:
-    if workflow.local_exec and workflow.is_main_process:
-        JOB_SERVER["process"] = job_server.start(
-            Path(workflow.basedir) / "workflow" / "scripts",
-            ".snakemake/job_server.log",
-        )
 
 
 # cancel_snakemake_timers: Snakemake's scheduler leaves a 1 s timer behind that the
 # process would wait for before exiting (chain.pipeline.run_end); with the wake-ups
 # coalesced above they are daemon threads, and this is the fallback.
 onsuccess:
-    job_server.stop(JOB_SERVER.pop("process", None))
+    job_server.stop(JOB_SERVER.pop("server", None))
     cancel_snakemake_timers()
 
 
 onerror:
-    job_server.stop(JOB_SERVER.pop("process", None))
+    job_server.stop(JOB_SERVER.pop("server", None))
     cancel_snakemake_timers()

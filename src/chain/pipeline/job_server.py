@@ -3,10 +3,12 @@
 A job of this workflow is a fresh Python process that spends most of its time starting
 up: ``import pandas`` 0.5-0.7 s, ``scipy.optimize`` 0.9 s, ``numba`` 0.8 s,
 ``matplotlib.pyplot`` 1.1 s, against a few tenths of a second of work for most steps.
-So a local run starts one server (:func:`start`, from the Snakefile's ``onstart``) that
-imports, once, every module the workflow's scripts import, and serves jobs on a Unix
-socket (from the start: a job that comes while it imports is served between two
-imports, and imports the rest itself).
+So a local run starts one server (:func:`start`, while Snakemake parses the workflow,
+so that it imports on the other core while Snakemake builds the DAG; :func:`publish`
+from the Snakefile's ``onstart``, once the run is known to be local) that imports,
+once, every module the workflow's scripts import, and serves jobs on a Unix socket
+(from the start: a job that comes while it imports is served between two imports, and
+imports the rest itself).
 Each job is still its own Snakemake job, with its own script, inputs, outputs, log and
 exit status; its process (the *client*) hands the job over (:func:`hand_off`, the first
 import of every script) and the server forks a child that runs the same script, with
@@ -37,6 +39,7 @@ import subprocess
 import sys
 import time
 import traceback
+from dataclasses import dataclass
 from pathlib import Path
 
 #: Environment variable: the server's address (set by :func:`start` for the jobs), or
@@ -127,11 +130,18 @@ def _socket_name(address: str) -> str:
 # ---- the server -----------------------------------------------------------------------
 
 
-def start(scripts: str | os.PathLike, log: str | os.PathLike) -> subprocess.Popen | None:
-    """Start the job server for the jobs of this process (a local Snakemake run) and
-    tell them where it is (:data:`ADDRESS_VARIABLE`). Returns at once: the server
-    imports while the first jobs are being scheduled, and a job that connects early
-    waits for it.
+@dataclass(frozen=True)
+class Server:
+    """A job server that :func:`start` started: its process and its address."""
+
+    process: subprocess.Popen
+    address: str
+
+
+def start(scripts: str | os.PathLike, log: str | os.PathLike) -> Server | None:
+    """Start a job server for the jobs of this process (a local Snakemake run). Returns
+    at once: the server imports while Snakemake goes on, and serves jobs once
+    :func:`publish` has told them where it is.
 
     Parameters
     ----------
@@ -142,33 +152,54 @@ def start(scripts: str | os.PathLike, log: str | os.PathLike) -> subprocess.Pope
 
     Returns
     -------
-    subprocess.Popen or None
-        The server's process; None if ``HERTZCHAIN_JOB_SERVER=off`` or not on Linux
-        (the jobs run in their own processes).
+    Server or None
+        The server; None if ``HERTZCHAIN_JOB_SERVER=off`` or not on Linux (the jobs run
+        in their own processes).
     """
     if os.environ.get(ADDRESS_VARIABLE) == "off" or not sys.platform.startswith("linux"):
         return None
     address = f"hertzchain-{os.getpid()}-{os.urandom(6).hex()}"
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as stream:
-        server = subprocess.Popen(
+        process = subprocess.Popen(
             [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
             stdin=subprocess.DEVNULL,
             stdout=stream,
             stderr=subprocess.STDOUT,
         )
-    os.environ[ADDRESS_VARIABLE] = address
-    return server
+    return Server(process, address)
 
 
-def stop(server: subprocess.Popen | None) -> None:
-    """Stop the server :func:`start` started (None: nothing to do); its running
-    children, if any, finish their jobs."""
-    os.environ.pop(ADDRESS_VARIABLE, None)
-    if server is not None and server.poll() is None:
-        server.terminate()
+def publish(server: Server | None) -> None:
+    """Hand this process's jobs to ``server`` from now on: its address goes in the
+    environment they inherit (:data:`ADDRESS_VARIABLE`). None: nothing to do.
+
+    Parameters
+    ----------
+    server : Server or None
+        What :func:`start` returned.
+    """
+    if server is not None:
+        os.environ[ADDRESS_VARIABLE] = server.address
+
+
+def stop(server: Server | None) -> None:
+    """Stop a server :func:`start` started (None: nothing to do) and take its address
+    back from the jobs; its running children, if any, finish their jobs.
+
+    Parameters
+    ----------
+    server : Server or None
+        What :func:`start` returned.
+    """
+    if server is None:
+        return
+    if os.environ.get(ADDRESS_VARIABLE) == server.address:
+        del os.environ[ADDRESS_VARIABLE]
+    if server.process.poll() is None:
+        server.process.terminate()
         with contextlib.suppress(subprocess.TimeoutExpired):
-            server.wait(timeout=10)
+            server.process.wait(timeout=10)
 
 
 def serve(address: str, scripts: Path) -> None:
