@@ -57,7 +57,6 @@ def test_a_process_with_snakemakes_pending_timer_exits_once_it_is_cancelled():
     assert done.stdout.split() == ["1"]
 
 
-
 def test_a_process_frozen_at_exit_keeps_its_exit_handlers_status_and_open_files(tmp_path):
     """freeze_at_exit skips the shutdown's collections: an exit handler registered
     before it runs after it and sees the objects frozen; the exit status is kept; a
