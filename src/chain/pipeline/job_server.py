@@ -42,7 +42,7 @@ import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-#: Environment variable: the server's address (set by :func:`start` for the jobs), or
+#: Environment variable: the server's address (set by :func:`publish` for the jobs), or
 #: ``off`` to run every job in its own process.
 ADDRESS_VARIABLE = "HERTZCHAIN_JOB_SERVER"
 
