@@ -508,6 +508,31 @@ def test_a_write_failing_midway_keeps_the_previous_file(tmp_path, monkeypatch):
     assert target.read_text() == "old,content\n"
 
 
+def test_an_interruption_as_the_temporary_file_appears_leaves_no_file(tmp_path, monkeypatch):
+    """SIGTERM the moment the temporary file exists (the interrupted rebuilds signal as
+    soon as a file of the watched folder appears): the job ends as a SIGTERM handler
+    ends it (SystemExit, raised at the next bytecode), and neither the temporary nor a
+    final file is left. The creating call raises it itself, so no clock decides where
+    it lands (``tempfile.mkstemp``, which made the file before its name was known,
+    failed this)."""
+    import chain.atomic
+
+    real_open = os.open
+
+    def open_then_interrupted(file, flags, *args, **kwargs):
+        made = real_open(file, flags, *args, **kwargs)
+        if flags & os.O_CREAT and Path(file).name.startswith(".t.csv."):
+            os.close(made)
+            raise SystemExit(128 + signal.SIGTERM)
+        return made
+
+    monkeypatch.setattr(chain.atomic.os, "open", open_then_interrupted)
+    with pytest.raises(SystemExit):
+        write_csv_atomic(pd.DataFrame({"a": [1.0], "b": [2.0]}), tmp_path / "t.csv")
+    monkeypatch.undo()
+    assert listing(tmp_path) == []
+
+
 def test_atomic_tables_get_ordinary_permissions(tmp_path):
     """Not the 0600 of a temporary file: others may read the results like any file."""
     umask = os.umask(0o022)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -35,6 +34,43 @@ def ordinary_mode(directory: bool = False) -> int:
 
 
 @contextmanager
+def temporary_beside(path: Path, directory: bool = False) -> Iterator[Path]:
+    """A new private file (or folder) beside ``path``, named ``.<name>.<random>``,
+    removed if the block raises or is interrupted.
+
+    The name is chosen before the file is made, so that an interruption at any moment
+    finds it: ``tempfile.mkstemp`` makes the file first and returns its name after, and
+    a signal in between (a watcher of the folder signals as soon as a file appears) left
+    it where no clean-up knew it.
+
+    Parameters
+    ----------
+    path : Path
+        The final destination, beside which the temporary goes.
+    directory : bool
+        A folder (0700) instead of an empty file (0600).
+    """
+    temporary = None
+    try:
+        while temporary is None:
+            temporary = path.parent / f".{path.name}.{os.urandom(4).hex()}"
+            try:
+                if directory:
+                    os.mkdir(temporary, 0o700)
+                else:
+                    os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+            except FileExistsError:
+                temporary = None  # another writer's: another name
+        yield temporary
+    except BaseException:
+        if temporary is not None and directory:
+            shutil.rmtree(temporary, ignore_errors=True)
+        elif temporary is not None:
+            temporary.unlink(missing_ok=True)
+        raise
+
+
+@contextmanager
 def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success rename it to ``path``.
 
@@ -49,15 +85,10 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    os.close(handle)
-    try:
-        yield Path(temporary)
+    with temporary_beside(path) as temporary:
+        yield temporary
         os.chmod(temporary, ordinary_mode())
         os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
 def write_text_atomic(text: str, path: str | os.PathLike) -> None:
@@ -104,8 +135,7 @@ def replace_folder(staging: Path, out: Path) -> None:
     if not out.exists():
         os.replace(staging, out)
         return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
-    old.rmdir()
+    old = out.parent / f".{out.name}.old.{os.urandom(4).hex()}"
     os.replace(out, old)
     os.replace(staging, out)
     shutil.rmtree(old, ignore_errors=True)

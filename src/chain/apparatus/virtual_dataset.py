@@ -5,8 +5,6 @@ measured-trace format, with the truth beside them (a MODEL; see
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 import warnings
 from dataclasses import asdict
 from pathlib import Path
@@ -19,7 +17,7 @@ from chain.apparatus.measured import FORMAT_NAME, METADATA_FILE, write_metadata,
 from chain.apparatus.virtual_plan import _plan
 from chain.apparatus.virtual_settings import VirtualExperiment
 from chain.apparatus.virtual_shots import simulate_virtual_shots
-from chain.atomic import ordinary_mode, replace_folder, write_text_atomic
+from chain.atomic import ordinary_mode, replace_folder, temporary_beside, write_text_atomic
 from chain.errors import ParameterError
 from chain.labels import VIRTUAL_LABEL
 from chain.physics.materials import Material
@@ -67,8 +65,7 @@ def run_virtual_experiment(
     time, forces = simulate_virtual_shots(settings, plan)
 
     out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with temporary_beside(out, directory=True) as staging:
         os.chmod(staging, ordinary_mode(directory=True))
         saturated = _write_shots(settings, plan, time, forces, rng, staging)
         if saturated.any():
@@ -83,9 +80,6 @@ def run_virtual_experiment(
         write_text_atomic(text, staging / TRUTH_FILE)
         write_metadata(staging, _metadata(settings, plan, dataset_name))
         replace_folder(staging, out)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
     return out
 
 
