@@ -315,3 +315,59 @@ def test_the_server_ends_with_the_process_that_started_it(scripts, tmp_path):
     )
     assert starter.returncode == 0, starter.stderr
     wait_gone(int(starter.stdout.split()[0]))
+
+
+def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path):
+    """The preload loads numba's kernels after the imports every job needs; a job whose
+    script imports the kernels' package, arriving first, has those steps (the package's
+    imports, the kernels) run before it is forked and nothing else, and the rest stays
+    in its order; a job that does not integrate changes nothing."""
+    from chain.pipeline import job_server
+
+    done: list[str] = []
+
+    def step(name: str, for_kernels: bool = False):
+        def run() -> None:
+            done.append(name)
+
+        if for_kernels:
+            run.for_kernels = True
+        return run
+
+    def pending() -> list:
+        return [
+            step("pandas"),
+            step("chain.physics.simulation", True),
+            step("matplotlib"),
+            step("kernels", True),
+            step("figures"),
+        ]
+
+    figure_job, integrating_job = tmp_path / "figure.py", tmp_path / "fields.py"
+    figure_job.write_text("import _hand_off\nimport pandas\nimport chain.report.figures\n")
+    integrating_job.write_text("import _hand_off\nfrom chain.physics.simulation import simulate\n")
+
+    steps = pending()
+    job_server._preload_for(str(figure_job), steps)
+    assert done == [] and len(steps) == 5
+
+    job_server._preload_for(str(integrating_job), steps)
+    assert done == ["chain.physics.simulation", "kernels"]
+    assert len(steps) == 3
+    for run in steps:
+        run()
+    assert done == ["chain.physics.simulation", "kernels", "pandas", "matplotlib", "figures"]
+
+
+def test_the_preload_marks_the_kernels_steps(tmp_path):
+    """The workflow's own preload: the kernels' package's imports and the kernels are
+    the steps marked for a job that integrates, after every other import and before the
+    figures' warm-up and the ready line."""
+    from chain.pipeline import job_server
+
+    steps = job_server._preload_steps(ROOT / "workflow" / "scripts", "address")
+    marked = [getattr(run, "for_kernels", False) for run in steps]
+    assert sum(marked) >= 2  # at least one module of chain.physics, and the kernels
+    first, last = marked.index(True), len(marked) - 1 - marked[::-1].index(True)
+    assert all(marked[first : last + 1])
+    assert last == len(steps) - 3  # then the figures' warm-up and the ready line

@@ -211,7 +211,9 @@ rule ssw_fields:
     log:
         f"{LOGS}/simulate/ssw_fields.log",
     cache: REUSE
-    priority: 1
+    # As soon as the tracks are there: the space-time figure and the article wait for
+    # it, and in a figure what-if it is the one job that computes before them.
+    priority: 3
     conda:
         ENV
     params:

@@ -32,6 +32,29 @@ from chain.pipeline.wakeups import coalesce_wakeups
 check_config(config)
 PLAN = RunPlan(config)
 
+
+# ---- the job server (chain.pipeline.job_server) ------------------------------------
+# A local run's jobs run in children of one process that imported their libraries once
+# (pandas, scipy, numba, matplotlib: 1.5-2.5 s a job otherwise). Each job keeps its own
+# process, script, log and status, and the same bytes. Not on a cluster (each job on
+# its node, as before), nor with HERTZCHAIN_JOB_SERVER=off. Started here, as soon as
+# the config passed its check, not in `onstart`: it imports on the other core while
+# Snakemake checks the datasets, reads the rules, builds the DAG and links stored
+# results (~2 s of one core in a what-if). The jobs learn its address in `onstart`,
+# where the run is known to be local; a cluster run stops it there. Not for a dry run;
+# a command that runs no job (--lint, --report) or fails a later check ends it with its
+# own exit.
+def start_job_server():
+    return job_server.start(
+        Path(workflow.basedir) / "workflow" / "scripts", ".snakemake/job_server.log"
+    )
+
+
+JOB_SERVER = {}
+if workflow.is_main_process and not getattr(workflow.output_settings, "dryrun", True):
+    JOB_SERVER["server"] = start_job_server()
+
+
 # ---- reuse across runs (issue 33; chain.pipeline.reuse) ---------------------------
 # Each deterministic step is marked `cache` (= REUSE); the workflow profile
 # (profiles/default, profiles/slurm) turns Snakemake's between-workflow cache on, and
@@ -113,27 +136,6 @@ check_experiment_datasets(config, list(PLAN.experiment))
 BAD_CHANNELS = bad_channel_policy(config)
 # The 5 % amplitude match of the experiment's collisions (rule selection).
 SELECTION = [f"{OUT}/experiment/selection.csv"] if EXPERIMENT_PARTS else []
-
-
-# ---- the job server (chain.pipeline.job_server) ------------------------------------
-# A local run's jobs run in children of one process that imported their libraries once
-# (pandas, scipy, numba, matplotlib: 1.5-2.5 s a job otherwise). Each job keeps its own
-# process, script, log and status, and the same bytes. Not on a cluster (each job on
-# its node, as before), nor with HERTZCHAIN_JOB_SERVER=off. Started here, once the
-# config and datasets passed their checks, not in `onstart`: it imports on the other
-# core while Snakemake reads the rules, builds the DAG and links stored results (~2 s
-# of one core in a what-if). The jobs learn its address in `onstart`, where the run is
-# known to be local; a cluster run stops it there. Not for a dry run; a command that
-# runs no job (--lint, --report) ends it with its own exit.
-def start_job_server():
-    return job_server.start(
-        Path(workflow.basedir) / "workflow" / "scripts", ".snakemake/job_server.log"
-    )
-
-
-JOB_SERVER = {}
-if workflow.is_main_process and not getattr(workflow.output_settings, "dryrun", True):
-    JOB_SERVER["server"] = start_job_server()
 
 
 onstart:

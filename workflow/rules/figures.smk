@@ -108,6 +108,10 @@ rule fig5_ssw_vs_force:
     log:
         f"{LOGS}/figures/fig5_ssw_vs_force.log",
     cache: REUSE
+    # The figure at the end of the longest chain of tables (ssw, ssw_fits) and the
+    # longest that waits for it: an analysis what-if started it after the shorter
+    # figures that were ready at the same time, and ended with it running alone.
+    priority: 1
     conda:
         ENV
     params:

@@ -46,6 +46,13 @@ from pathlib import Path
 #: ``off`` to run every job in its own process.
 ADDRESS_VARIABLE = "HERTZCHAIN_JOB_SERVER"
 
+#: The package whose modules hold numba kernels (chain.physics): preloaded first.
+KERNEL_PACKAGE = "chain.physics"
+
+#: What Snakemake's preamble of a Python script imports, in each job's process before
+#: the script's first line (snakemake.script.PythonScript.generate_preamble; ~0.13 s).
+PREAMBLE_IMPORTS = ("snakemake.iocontainers", "snakemake.logging")
+
 #: Set in the server's children: a job already in the server runs where it is.
 _IN_SERVER = False
 
@@ -56,6 +63,7 @@ _SERVER_LOG = 1
 _SIGNAL_BASE = 128
 
 _HEADER = struct.Struct("!Q")  # length of the pickled request
+_REQUEST_TIMEOUT = 10.0  # s: a client sends its request as soon as it has connected
 _STATUS = struct.Struct("!q")  # the child's pid, then its exit status
 
 
@@ -209,7 +217,8 @@ def serve(address: str, scripts: Path) -> None:
 
     The imports run one module at a time, between jobs: a job that arrives first is
     forked at once, with what is imported so far, and imports the rest itself, as it
-    would in its own process. A run of a few jobs (a figure what-if) does not wait for
+    would in its own process; one that integrates has the kernels loaded first
+    (:func:`_preload_for`). A run of a few jobs (a figure what-if) does not wait for
     the whole preload (~3 s) before its first job; a long run soon has it all.
 
     Parameters
@@ -238,19 +247,32 @@ def serve(address: str, scripts: Path) -> None:
             if steps:
                 steps.pop(0)()
             continue
-        connection.settimeout(None)
+        try:
+            connection.settimeout(_REQUEST_TIMEOUT)
+            request, fds = _read_request(connection)
+            connection.settimeout(None)
+        except Exception:  # a client gone or garbled: no pid, so it runs the job itself
+            connection.close()
+            continue
+        _preload_for(request["script"], steps)
         if os.fork() == 0:
             listener.close()
-            _run_child(connection)  # never returns
+            _run_child(connection, request, fds)  # never returns
+        for fd in fds:
+            os.close(fd)
         connection.close()
 
 
 def _preload_steps(scripts: Path, address: str) -> list:
     """The server's preload as steps to run between jobs: one import per module the
     ``scripts`` import at their top level (their local helpers too; one that fails is
-    left for the job to report), then the figures' warm-up
-    (:func:`chain.report.figures.style.warm_up`), then numba's cached kernels, then the
-    "ready" line."""
+    left for the job to report), Snakemake's preamble's (:data:`PREAMBLE_IMPORTS`) and
+    :data:`KERNEL_PACKAGE`'s first; numba's cached kernels once those are in; the
+    figures' warm-up (:func:`chain.report.figures.style.warm_up`) and the "ready" line
+    last.
+
+    The kernels' steps are marked (``for_kernels``): a job that integrates and comes
+    before them has them run first (:func:`_preload_for`)."""
 
     def importing(module: str):
         def step() -> None:
@@ -274,11 +296,54 @@ def _preload_steps(scripts: Path, address: str) -> list:
         except Exception as error:  # a figure job that fails so reports it itself
             print(f"job server: no warm-up of the figures: {error!r}", flush=True)
 
-    def kernels() -> None:
-        loaded = _load_cached_kernels()
-        print(f"job server: ready at {address} ({loaded} numba kernels loaded)", flush=True)
+    loaded = []
 
-    return [*(importing(m) for m in sorted(_top_level_imports(scripts))), figures, kernels]
+    def kernels() -> None:
+        loaded.append(_load_cached_kernels())
+
+    def ready() -> None:
+        print(f"job server: ready at {address} ({loaded[0]} numba kernels loaded)", flush=True)
+
+    modules = sorted(_top_level_imports(scripts) - set(PREAMBLE_IMPORTS))
+    kernel_steps = [importing(m) for m in modules if _defines_kernels(m)] + [kernels]
+    for step in kernel_steps:
+        step.for_kernels = True
+    return [
+        *(importing(m) for m in (*PREAMBLE_IMPORTS, *modules) if not _defines_kernels(m)),
+        *kernel_steps,
+        figures,
+        ready,
+    ]
+
+
+def _preload_for(script: str, steps: list) -> None:
+    """Run now, for a job that integrates, the kernels' preload steps still in
+    ``steps``; leave the rest in their order.
+
+    The kernels load late in the preload, after the imports that every analysis or
+    figure job needs; a figure what-if's first computing job integrates
+    (``ssw_fields``, on the way to the space-time figure and the article), and forked
+    before them it read them from disk itself (~1 s) while the server did the same on
+    the other core.
+
+    Parameters
+    ----------
+    script : str
+        The job's script (Snakemake's copy, with its preamble).
+    steps : list
+        The pending preload steps (:func:`_preload_steps`); the run ones are removed.
+    """
+    pending = [step for step in steps if getattr(step, "for_kernels", False)]
+    if not pending or not any(map(_defines_kernels, _script_imports(Path(script)))):
+        return
+    for step in pending:
+        steps.remove(step)
+        step()
+
+
+def _defines_kernels(module: str) -> bool:
+    """Whether ``module`` is one of :data:`KERNEL_PACKAGE`'s."""
+    return module.startswith(KERNEL_PACKAGE)
 
 
 def _die_with_parent() -> None:
@@ -344,32 +409,40 @@ def _top_level_imports(scripts: Path) -> set[str]:
     """Modules the scripts of ``scripts`` import in their top-level statements."""
     modules: set[str] = set()
     for path in scripts.glob("*.py"):
-        try:
-            body = ast.parse(path.read_text(), filename=str(path)).body
-        except (SyntaxError, ValueError, OSError):
-            continue  # its job reports it, run as it would be without a server
-        for node in body:
-            if isinstance(node, ast.Import):
-                modules.update(alias.name for alias in node.names)
-            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
-                modules.add(node.module)
+        modules |= _script_imports(path)
     return modules - {"_hand_off"}
+
+
+def _script_imports(path: Path) -> set[str]:
+    """Modules one script imports in its top-level statements (none if unreadable: its
+    job reports that, run as it would be without a server)."""
+    try:
+        body = ast.parse(path.read_text(), filename=str(path)).body
+    except (SyntaxError, ValueError, OSError):
+        return set()
+    modules: set[str] = set()
+    for node in body:
+        if isinstance(node, ast.Import):
+            modules.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            modules.add(node.module)
+    return modules
 
 
 # ---- a child: one job -------------------------------------------------------------------
 
 
-def _run_child(connection: socket.socket) -> None:
-    """Take the job's request, become its process (streams, directory, environment)
-    and run its script; report the exit status and exit. Never returns. A child that
-    fails before it has sent its pid closes without a word, and the client runs the
-    job itself."""
+def _run_child(connection: socket.socket, request: dict, fds: list[int]) -> None:
+    """Become the process of the job that sent ``request`` and the streams ``fds``
+    (:func:`_read_request`) and run its script; report the exit status and exit. Never
+    returns. A child that fails before it has sent its pid closes without a word, and
+    the client runs the job itself."""
     global _IN_SERVER
     _IN_SERVER = True
     _signals_once()
     started, status = False, 1
     try:
-        request = _take_request(connection)
+        _adopt(request, fds)
         connection.sendall(_STATUS.pack(os.getpid()))
         started = True
         _stop_when_client_dies(connection)
@@ -397,20 +470,31 @@ def _log(line: str) -> None:
         os.write(_SERVER_LOG, f"job server: pid {os.getpid()}: {line}\n".encode())
 
 
-def _take_request(connection: socket.socket) -> dict:
-    """Read the request and adopt the client's streams, directory, environment and
-    import path."""
+def _read_request(connection: socket.socket) -> tuple[dict, list[int]]:
+    """A client's request (script, directory, environment, import path) and its
+    streams' file descriptors (stdin, stdout, stderr)."""
+    header, fds, _, _ = socket.recv_fds(connection, _HEADER.size, 3)
+    try:
+        if len(header) != _HEADER.size or len(fds) != 3:
+            raise ConnectionError("the client closed before its request was read")
+        (length,) = _HEADER.unpack(header)
+        data = b""
+        while len(data) < length:
+            chunk = connection.recv(length - len(data))
+            if not chunk:
+                raise ConnectionError("the client closed before its request was read")
+            data += chunk
+        return pickle.loads(data), fds
+    except BaseException:
+        for fd in fds:
+            os.close(fd)
+        raise
+
+
+def _adopt(request: dict, fds: list[int]) -> None:
+    """Take the client's streams, directory, environment and import path."""
     import tempfile
 
-    header, fds, _, _ = socket.recv_fds(connection, _HEADER.size, 3)
-    (length,) = _HEADER.unpack(header)
-    data = b""
-    while len(data) < length:
-        chunk = connection.recv(length - len(data))
-        if not chunk:
-            raise ConnectionError("the client closed before its request was read")
-        data += chunk
-    request = pickle.loads(data)
     for target, fd in enumerate(fds):
         os.dup2(fd, target)
         os.close(fd)
@@ -424,7 +508,6 @@ def _take_request(connection: socket.socket) -> dict:
     tempfile.tempdir = None  # TMPDIR is the job's (a resource of the rule)
     sys.path[:] = request["path"]
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the job's own children are waited for
-    return request
 
 
 def stop_once(signum: int, frame) -> None:
