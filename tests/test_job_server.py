@@ -317,57 +317,35 @@ def test_the_server_ends_with_the_process_that_started_it(scripts, tmp_path):
     wait_gone(int(starter.stdout.split()[0]))
 
 
-def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path):
-    """The preload loads numba's kernels after the imports every job needs; a job whose
-    script imports the kernels' package, arriving first, has those steps (the package's
-    imports, the kernels) run before it is forked and nothing else, and the rest stays
-    in its order; a job that does not integrate changes nothing."""
+def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path, monkeypatch):
+    """numba's cached kernels are loaded before each job whose script imports the
+    kernels' package (once its modules are imported), never for one that does not, and
+    are no step of the preload (an analysis what-if integrates nothing)."""
     from chain.pipeline import job_server
 
-    done: list[str] = []
-
-    def step(name: str, for_kernels: bool = False):
-        def run() -> None:
-            done.append(name)
-
-        if for_kernels:
-            run.for_kernels = True
-        return run
-
-    def pending() -> list:
-        return [
-            step("pandas"),
-            step("chain.physics.simulation", True),
-            step("matplotlib"),
-            step("kernels", True),
-            step("figures"),
-        ]
-
+    calls: list[int] = []
+    monkeypatch.setattr(job_server, "_load_cached_kernels", lambda: calls.append(1) or 0)
     figure_job, integrating_job = tmp_path / "figure.py", tmp_path / "fields.py"
     figure_job.write_text("import _hand_off\nimport pandas\nimport chain.report.figures\n")
     integrating_job.write_text("import _hand_off\nfrom chain.physics.simulation import simulate\n")
 
-    steps = pending()
-    job_server._preload_for(str(figure_job), steps)
-    assert done == [] and len(steps) == 5
-
-    job_server._preload_for(str(integrating_job), steps)
-    assert done == ["chain.physics.simulation", "kernels"]
-    assert len(steps) == 3
-    for run in steps:
-        run()
-    assert done == ["chain.physics.simulation", "kernels", "pandas", "matplotlib", "figures"]
+    job_server._load_kernels_for(str(figure_job))
+    assert calls == []
+    job_server._load_kernels_for(str(integrating_job))
+    job_server._load_kernels_for(str(integrating_job))
+    assert calls == [1, 1]
+    assert "chain.physics.simulation" in sys.modules
 
 
-def test_the_preload_marks_the_kernels_steps(tmp_path):
-    """The workflow's own preload: the kernels' package's imports and the kernels are
-    the steps marked for a job that integrates, after every other import and before the
-    figures' warm-up and the ready line."""
+def test_the_preload_imports_the_preamble_first_and_ends_ready(tmp_path):
+    """The workflow's own preload: Snakemake's preamble's imports first (every job's
+    process runs them before its script), the figures' warm-up and the ready line last;
+    every other step an import of the scripts."""
     from chain.pipeline import job_server
 
     steps = job_server._preload_steps(ROOT / "workflow" / "scripts", "address")
-    marked = [getattr(run, "for_kernels", False) for run in steps]
-    assert sum(marked) >= 2  # at least one module of chain.physics, and the kernels
-    first, last = marked.index(True), len(marked) - 1 - marked[::-1].index(True)
-    assert all(marked[first : last + 1])
-    assert last == len(steps) - 3  # then the figures' warm-up and the ready line
+    names = [step.__name__ for step in steps]
+    assert names[-2:] == ["figures", "ready"]
+    assert set(names[:-2]) == {"step"}
+    preamble = [step.__closure__[0].cell_contents for step in steps[:2]]
+    assert preamble == list(job_server.PREAMBLE_IMPORTS)

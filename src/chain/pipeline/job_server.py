@@ -46,7 +46,7 @@ from pathlib import Path
 #: ``off`` to run every job in its own process.
 ADDRESS_VARIABLE = "HERTZCHAIN_JOB_SERVER"
 
-#: The package whose modules hold numba kernels (chain.physics): preloaded first.
+#: The package whose modules hold numba kernels (chain.physics).
 KERNEL_PACKAGE = "chain.physics"
 
 #: What Snakemake's preamble of a Python script imports, in each job's process before
@@ -213,12 +213,13 @@ def stop(server: Server | None) -> None:
 def serve(address: str, scripts: Path) -> None:
     """The server's main loop: listen at ``address``, fork a child per job until the
     parent (Snakemake) is gone or a SIGTERM or SIGINT arrives (then it exits at once),
-    and meanwhile import what the ``scripts`` import and load numba's cached kernels.
+    and meanwhile import what the ``scripts`` import; load numba's cached kernels before
+    each job that integrates.
 
     The imports run one module at a time, between jobs: a job that arrives first is
     forked at once, with what is imported so far, and imports the rest itself, as it
     would in its own process; one that integrates has the kernels loaded first
-    (:func:`_preload_for`). A run of a few jobs (a figure what-if) does not wait for
+    (:func:`_load_kernels_for`). A run of a few jobs (a figure what-if) does not wait for
     the whole preload (~3 s) before its first job; a long run soon has it all.
 
     Parameters
@@ -254,7 +255,7 @@ def serve(address: str, scripts: Path) -> None:
         except Exception:  # a client gone or garbled: no pid, so it runs the job itself
             connection.close()
             continue
-        _preload_for(request["script"], steps)
+        _load_kernels_for(request["script"])
         if os.fork() == 0:
             listener.close()
             _run_child(connection, request, fds)  # never returns
@@ -266,13 +267,9 @@ def serve(address: str, scripts: Path) -> None:
 def _preload_steps(scripts: Path, address: str) -> list:
     """The server's preload as steps to run between jobs: one import per module the
     ``scripts`` import at their top level (their local helpers too; one that fails is
-    left for the job to report), Snakemake's preamble's (:data:`PREAMBLE_IMPORTS`) and
-    :data:`KERNEL_PACKAGE`'s first; numba's cached kernels once those are in; the
-    figures' warm-up (:func:`chain.report.figures.style.warm_up`) and the "ready" line
-    last.
-
-    The kernels' steps are marked (``for_kernels``): a job that integrates and comes
-    before them has them run first (:func:`_preload_for`)."""
+    left for the job to report), Snakemake's preamble's (:data:`PREAMBLE_IMPORTS`)
+    first, then the figures' warm-up (:func:`chain.report.figures.style.warm_up`) and
+    the "ready" line. numba's kernels are not part of it: :func:`_load_kernels_for`."""
 
     def importing(module: str):
         def step() -> None:
@@ -296,49 +293,39 @@ def _preload_steps(scripts: Path, address: str) -> list:
         except Exception as error:  # a figure job that fails so reports it itself
             print(f"job server: no warm-up of the figures: {error!r}", flush=True)
 
-    loaded = []
-
-    def kernels() -> None:
-        loaded.append(_load_cached_kernels())
-
     def ready() -> None:
-        print(f"job server: ready at {address} ({loaded[0]} numba kernels loaded)", flush=True)
+        print(f"job server: ready at {address}", flush=True)
 
     modules = sorted(_top_level_imports(scripts) - set(PREAMBLE_IMPORTS))
-    kernel_steps = [importing(m) for m in modules if _defines_kernels(m)] + [kernels]
-    for step in kernel_steps:
-        step.for_kernels = True
-    return [
-        *(importing(m) for m in (*PREAMBLE_IMPORTS, *modules) if not _defines_kernels(m)),
-        *kernel_steps,
-        figures,
-        ready,
-    ]
+    return [*(importing(m) for m in (*PREAMBLE_IMPORTS, *modules)), figures, ready]
 
 
-def _preload_for(script: str, steps: list) -> None:
-    """Run now, for a job that integrates, the kernels' preload steps still in
-    ``steps``; leave the rest in their order.
+def _load_kernels_for(script: str) -> None:
+    """Before a job that integrates is forked: load, from numba's cache, the kernel
+    versions the server does not hold yet (importing the kernels' modules first).
 
-    The kernels load late in the preload, after the imports that every analysis or
-    figure job needs; a figure what-if's first computing job integrates
-    (``ssw_fields``, on the way to the space-time figure and the article), and forked
-    before them it read them from disk itself (~1 s) while the server did the same on
-    the other core.
+    A job forked without them read them from disk itself (~1 s; a figure what-if's
+    first computing job, ``ssw_fields``, in most rounds), while a run that integrates
+    nothing (an analysis what-if) has no use for them. Asked each time, the cache also
+    gives the later jobs of a run the versions its first jobs compiled. A job that does
+    not integrate is forked at once.
 
     Parameters
     ----------
     script : str
         The job's script (Snakemake's copy, with its preamble).
-    steps : list
-        The pending preload steps (:func:`_preload_steps`); the run ones are removed.
     """
-    pending = [step for step in steps if getattr(step, "for_kernels", False)]
-    if not pending or not any(map(_defines_kernels, _script_imports(Path(script)))):
+    modules = [m for m in _script_imports(Path(script)) if _defines_kernels(m)]
+    if not modules:
         return
-    for step in pending:
-        steps.remove(step)
-        step()
+    for module in modules:
+        try:
+            importlib.import_module(module)
+        except Exception:  # the job, importing it, fails the same way
+            return
+    loaded = _load_cached_kernels()
+    if loaded:
+        print(f"job server: {loaded} numba kernel versions loaded", flush=True)
 
 
 def _defines_kernels(module: str) -> bool:
