@@ -8,7 +8,8 @@ so that it imports on the other core while Snakemake builds the DAG; :func:`publ
 from the Snakefile's ``onstart``, once the run is known to be local) that imports,
 once, every module the workflow's scripts import, and serves jobs on a Unix socket
 (from the start: a job that comes while it imports is served between two imports, and
-imports the rest itself).
+imports the rest itself); before each job that integrates it loads the kernel versions
+numba's cache holds that it does not.
 Each job is still its own Snakemake job, with its own script, inputs, outputs, log and
 exit status; its process (the *client*) hands the job over (:func:`hand_off`, the first
 import of every script) and the server forks a child that runs the same script, with
