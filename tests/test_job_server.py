@@ -321,18 +321,18 @@ def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path,
     """numba's cached kernels are loaded before each job whose script imports the
     kernels' package (once its modules are imported), never for one that does not, and
     are no step of the preload (an analysis what-if integrates nothing)."""
-    from chain.pipeline import job_server
+    from chain.pipeline import preload
 
     calls: list[int] = []
-    monkeypatch.setattr(job_server, "_load_cached_kernels", lambda: calls.append(1) or 0)
+    monkeypatch.setattr(preload, "_load_cached_kernels", lambda: calls.append(1) or 0)
     figure_job, integrating_job = tmp_path / "figure.py", tmp_path / "fields.py"
     figure_job.write_text("import _hand_off\nimport pandas\nimport chain.report.figures\n")
     integrating_job.write_text("import _hand_off\nfrom chain.physics.simulation import simulate\n")
 
-    job_server._load_kernels_for(str(figure_job))
+    preload.load_kernels_for(str(figure_job))
     assert calls == []
-    job_server._load_kernels_for(str(integrating_job))
-    job_server._load_kernels_for(str(integrating_job))
+    preload.load_kernels_for(str(integrating_job))
+    preload.load_kernels_for(str(integrating_job))
     assert calls == [1, 1]
     assert "chain.physics.simulation" in sys.modules
 
@@ -341,11 +341,11 @@ def test_the_preload_imports_the_preamble_first_and_ends_ready(tmp_path):
     """The workflow's own preload: Snakemake's preamble's imports first (every job's
     process runs them before its script), the figures' warm-up and the ready line last;
     every other step an import of the scripts."""
-    from chain.pipeline import job_server
+    from chain.pipeline import preload
 
-    steps = job_server._preload_steps(ROOT / "workflow" / "scripts", "address")
+    steps = preload.preload_steps(ROOT / "workflow" / "scripts", "address")
     names = [step.__name__ for step in steps]
     assert names[-2:] == ["figures", "ready"]
     assert set(names[:-2]) == {"step"}
     preamble = [step.__closure__[0].cell_contents for step in steps[:2]]
-    assert preamble == list(job_server.PREAMBLE_IMPORTS)
+    assert preamble == list(preload.PREAMBLE_IMPORTS)
