@@ -533,13 +533,15 @@ style.save_figure(fig, sys.argv[2])
 
 
 def test_a_warmed_up_process_saves_the_bytes_of_a_cold_one(tmp_path):
-    """style.warm_up (run by the job server before it forks the jobs) builds
-    matplotlib's mathtext parser and loads the fonts and the PDF backend: a figure
-    saved after it has the bytes of one saved by a fresh interpreter, PDF and PNG
-    (Fig. 4: log axes and mathtext labels)."""
+    """The figures' warm-up (chain.report.figures.warm_up, run in steps by the job
+    server before it forks the jobs) builds matplotlib's mathtext parser and loads the fonts
+    and the PDF backend: a figure saved after it has the bytes of one saved by a fresh
+    interpreter, PDF and PNG (Fig. 4: log axes and mathtext labels)."""
     import pickle
     import subprocess
     import sys
+
+    from chain.report.figures.warm_up import warm_up_steps
 
     constants = {"C_bal_paper_us_N16": 49.75, "C_bal_exact_us_N16": 37.74}
     inputs = (delays_table(), delay_fits_table(), constants)
@@ -552,7 +554,8 @@ def test_a_warmed_up_process_saves_the_bytes_of_a_cold_one(tmp_path):
         check=False,
     )
     assert done.returncode == 0, done.stderr[-3000:]
-    style.warm_up()
+    for step in warm_up_steps():
+        step()
     warm = style.save_figure(
         fig4_delay_vs_force(inputs[0], inputs[1], constants=inputs[2]), tmp_path / "warm" / "fig4"
     )

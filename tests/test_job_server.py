@@ -318,34 +318,46 @@ def test_the_server_ends_with_the_process_that_started_it(scripts, tmp_path):
 
 
 def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path, monkeypatch):
-    """numba's cached kernels are loaded before each job whose script imports the
-    kernels' package (once its modules are imported), never for one that does not, and
-    are no step of the preload (an analysis what-if integrates nothing)."""
+    """numba's cached kernels are loaded before each job whose script runs them, by
+    whatever path of the library (the simulations import them through
+    ``chain.apparatus``), never for one that does not (Fig. 4 imports the closed forms
+    of ``chain.physics``, no kernel: an analysis what-if integrates nothing)."""
     from chain.pipeline import preload
 
-    calls: list[int] = []
-    monkeypatch.setattr(preload, "_load_cached_kernels", lambda: calls.append(1) or 0)
-    figure_job, integrating_job = tmp_path / "figure.py", tmp_path / "fields.py"
-    figure_job.write_text("import _hand_off\nimport pandas\nimport chain.report.figures\n")
-    integrating_job.write_text("import _hand_off\nfrom chain.physics.simulation import simulate\n")
+    calls: list[str] = []
+    monkeypatch.setattr(preload, "_load_cached_kernels", lambda: calls.append("load") or 0)
+    jobs = {
+        "figure": "import pandas\nimport chain.report.figures\n",
+        "closed_forms": "from chain.physics.theory import ballistic_constants\n",
+        "fields": "from chain.physics.simulation import simulate\n",
+        "shots": "from chain.apparatus.shots import simulate_shots\n",
+    }
+    for name, imports in jobs.items():
+        (tmp_path / f"{name}.py").write_text(f"import _hand_off\n{imports}")
 
-    preload.load_kernels_for(str(figure_job))
-    assert calls == []
-    preload.load_kernels_for(str(integrating_job))
-    preload.load_kernels_for(str(integrating_job))
-    assert calls == [1, 1]
-    assert "chain.physics.simulation" in sys.modules
+    loads = {}
+    for name in jobs:
+        calls.clear()
+        preload.load_kernels_for(str(tmp_path / f"{name}.py"))
+        loads[name] = len(calls)
+    assert loads == {"figure": 0, "closed_forms": 0, "fields": 1, "shots": 1}
+    assert "chain.physics.kernels" in sys.modules
 
 
-def test_the_preload_imports_the_preamble_first_and_ends_ready(tmp_path):
-    """The workflow's own preload: Snakemake's preamble's imports first (every job's
-    process runs them before its script), the figures' warm-up and the ready line last;
-    every other step an import of the scripts."""
+def test_the_preload_imports_the_preamble_first_and_ends_ready(capsys):
+    """The workflow's own preload, step by step as the server runs it: Snakemake's
+    preamble's imports first (every job's process runs them before its script), then
+    the scripts' imports, the figures' warm-up in its three steps (the scripts draw
+    figures) and the ready line last."""
     from chain.pipeline import preload
 
-    steps = preload.preload_steps(ROOT / "workflow" / "scripts", "address")
-    names = [step.__name__ for step in steps]
-    assert names[-2:] == ["figures", "ready"]
-    assert set(names[:-2]) == {"step"}
-    preamble = [step.__closure__[0].cell_contents for step in steps[:2]]
+    names, preamble = [], []
+    for step in preload.preload_steps(ROOT / "workflow" / "scripts", "address"):
+        names.append(step.__name__)
+        if len(preamble) < len(preload.PREAMBLE_IMPORTS):
+            preamble.append(step.__closure__[0].cell_contents)
+        step()
     assert preamble == list(preload.PREAMBLE_IMPORTS)
+    assert names[-4:] == ["warm_up", "warm_up", "warm_up", "ready"]
+    assert set(names[:-4]) == {"step"}
+    assert capsys.readouterr().out == "job server: ready at address\n"  # nothing failed

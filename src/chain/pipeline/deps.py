@@ -163,6 +163,18 @@ def _targets(root: Path, module: str, names: list[str]) -> list[Path]:
     return files
 
 
+def imported_packages(path: str | os.PathLike) -> set[str]:
+    """The top-level packages a source file imports anywhere in it (``numba`` for
+    ``from numba.core import types``), read as for :func:`script_sources`.
+
+    Parameters
+    ----------
+    path : path
+        A Python source file.
+    """
+    return {module.split(".")[0] for module, _ in _imported_names(Path(path)) if module}
+
+
 def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) -> list[str]:
     """Source files a workflow script runs, besides itself: its local helpers and the
     package files it imports, transitively.

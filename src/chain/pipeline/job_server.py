@@ -81,7 +81,13 @@ def hand_off(script: str | None) -> None:
         connection = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         connection.connect(_socket_name(address))
         request = pickle.dumps(
-            {"script": script, "cwd": os.getcwd(), "env": dict(os.environ), "path": sys.path}
+            {
+                "script": script,
+                "cwd": os.getcwd(),
+                "env": dict(os.environ),
+                "path": sys.path,
+                "sent": time.time(),  # for the server's log: how long the job waited
+            }
         )
         socket.send_fds(connection, [_HEADER.pack(len(request))], [0, 1, 2])
         connection.sendall(request)
@@ -235,13 +241,16 @@ def serve(address: str, scripts: Path) -> None:
         signal.signal(signum, lambda signum, frame: os._exit(0))
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # children reap themselves
     steps = preload_steps(scripts, address)
+    preloading = True
     while os.getppid() == parent:
-        listener.settimeout(0.0 if steps else 1.0)  # no wait while there is preloading
+        listener.settimeout(0.0 if preloading else 1.0)  # no wait while there is preloading
         try:
             connection, _ = listener.accept()
         except (TimeoutError, BlockingIOError):
-            if steps:
-                steps.pop(0)()
+            if preloading and (step := next(steps, None)):
+                step()
+            else:
+                preloading = False
             continue
         try:
             connection.settimeout(_REQUEST_TIMEOUT)
@@ -284,10 +293,13 @@ def _run_child(connection: socket.socket, request: dict, fds: list[int]) -> None
         connection.sendall(_STATUS.pack(os.getpid()))
         started = True
         _stop_when_client_dies(connection)
+        waited = time.time() - request.get("sent", time.time())
         begun = time.perf_counter()
         status = _run_script(request["script"])
+        took = time.perf_counter() - begun
         _log(
-            f"{Path(request['script']).name}: status {status}, {time.perf_counter() - begun:.2f} s"
+            f"{Path(request['script']).name}: status {status}, {took:.2f} s, "
+            f"forked {waited:.2f} s after its request"
         )
     finally:
         # Nothing may interrupt the way out (the watcher's SIGTERM once the client has

@@ -10,25 +10,38 @@ from __future__ import annotations
 
 import ast
 import importlib
+import importlib.util
 import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
+
+#: The library (its modules are followed to the kernels).
+PACKAGE = "chain"
 
 #: The package whose modules hold numba kernels (chain.physics).
 KERNEL_PACKAGE = "chain.physics"
+
+#: The figures' style: a script imported it, so the server's jobs draw figures.
+FIGURES_STYLE = "chain.report.figures.style"
+
+#: The figures' warm-up (the report's, which the pipeline does not import: looked up
+#: by name, once a script has imported the figures' style).
+FIGURES_WARM_UP = "chain.report.figures.warm_up"
 
 #: What Snakemake's preamble of a Python script imports, in each job's process before
 #: the script's first line (snakemake.script.PythonScript.generate_preamble; ~0.13 s).
 PREAMBLE_IMPORTS = ("snakemake.iocontainers", "snakemake.logging")
 
 
-def preload_steps(scripts: Path, address: str) -> list:
-    """The server's preload as steps to run between jobs: one import per module the
-    ``scripts`` import at their top level (their local helpers too; one that fails is
-    left for the job to report), Snakemake's preamble's (:data:`PREAMBLE_IMPORTS`)
-    first, then the figures' warm-up (:func:`chain.report.figures.style.warm_up`) and
-    the "ready" line. numba's kernels are not part of it: :func:`load_kernels_for`."""
+def preload_steps(scripts: Path, address: str) -> Iterator[Callable[[], None]]:
+    """The server's preload as steps to run between jobs, one at a time: one import per
+    module the ``scripts`` import at their top level (their local helpers too; one that
+    fails is left for the job to report), Snakemake's preamble's
+    (:data:`PREAMBLE_IMPORTS`) first; then, if a script draws figures, the figures'
+    warm-up (:data:`FIGURES_WARM_UP`, three steps); then the "ready" line. numba's
+    kernels are not part of it: :func:`load_kernels_for`."""
 
-    def importing(module: str):
+    def importing(module: str) -> Callable[[], None]:
         def step() -> None:
             sys.path.insert(0, str(scripts))
             try:
@@ -40,21 +53,38 @@ def preload_steps(scripts: Path, address: str) -> list:
 
         return step
 
-    def figures() -> None:
-        # A figure job's first save built matplotlib's mathtext parser, imported the
-        # PDF backend and loaded the fonts (~0.4 s a job): once here instead.
-        style = sys.modules.get("chain.report.figures.style")
-        try:
-            if style is not None:
-                style.warm_up()
-        except Exception as error:  # a figure job that fails so reports it itself
-            print(f"job server: no warm-up of the figures: {error!r}", flush=True)
-
     def ready() -> None:
         print(f"job server: ready at {address}", flush=True)
 
     modules = sorted(_top_level_imports(scripts) - set(PREAMBLE_IMPORTS))
-    return [*(importing(m) for m in (*PREAMBLE_IMPORTS, *modules)), figures, ready]
+    for module in (*PREAMBLE_IMPORTS, *modules):
+        yield importing(module)
+    if FIGURES_STYLE in sys.modules:
+        yield from map(_reported, _figures_warm_up())
+    yield ready
+
+
+def _figures_warm_up() -> list[Callable[[], None]]:
+    """The warm-up's steps (none if its module fails to import: the figure jobs report
+    what fails)."""
+    try:
+        return importlib.import_module(FIGURES_WARM_UP).warm_up_steps()
+    except Exception as error:
+        print(f"job server: no warm-up of the figures: {error!r}", flush=True)
+        return []
+
+
+def _reported(step: Callable[[], None]) -> Callable[[], None]:
+    """``step``, with an error printed in the server's log instead of raised (a figure
+    job that fails the same way reports it itself)."""
+
+    def warm_up() -> None:
+        try:
+            step()
+        except Exception as error:
+            print(f"job server: no warm-up of the figures: {error!r}", flush=True)
+
+    return warm_up
 
 
 def load_kernels_for(script: str) -> None:
@@ -72,7 +102,7 @@ def load_kernels_for(script: str) -> None:
     script : str
         The job's script (Snakemake's copy, with its preamble).
     """
-    modules = [m for m in _script_imports(Path(script)) if _defines_kernels(m)]
+    modules = _kernel_modules_run_by(Path(script))
     if not modules:
         return
     for module in modules:
@@ -85,9 +115,28 @@ def load_kernels_for(script: str) -> None:
         print(f"job server: {loaded} numba kernel versions loaded", flush=True)
 
 
-def _defines_kernels(module: str) -> bool:
-    """Whether ``module`` is one of :data:`KERNEL_PACKAGE`'s."""
-    return module.startswith(KERNEL_PACKAGE)
+def _kernel_modules_run_by(script: Path) -> list[str]:
+    """The modules of :data:`KERNEL_PACKAGE` that import numba and that ``script``
+    runs: through every package module it imports, followed as for its code inputs
+    (:func:`chain.pipeline.deps.script_sources`). A script that imports the package's
+    closed forms (Fig. 4) or a study that simulates (through ``chain.apparatus``)
+    is told apart by what it reaches, not by what it names."""
+    from chain.pipeline.deps import imported_packages, script_sources
+
+    package = Path(importlib.util.find_spec(PACKAGE).origin).parent
+    try:
+        sources = [(Path.cwd() / name).resolve() for name in script_sources(script, package)]
+    except (OSError, SyntaxError, ValueError):  # the job reports it, run as it would be
+        return []
+    modules = []
+    for source in sources:
+        if not source.is_relative_to(package):
+            continue  # the script's local helpers
+        parts = source.relative_to(package.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        if name.startswith(KERNEL_PACKAGE + ".") and "numba" in imported_packages(source):
+            modules.append(name)
+    return sorted(modules)
 
 
 def _load_cached_kernels() -> int:

@@ -73,25 +73,6 @@ MICRO = 1e6
 # ---- saving ---------------------------------------------------------------------
 
 
-def warm_up() -> None:
-    """Draw and save a small figure, into memory, once: a process forked after this
-    (the job server's children, :mod:`chain.pipeline.job_server`) finds matplotlib's
-    PDF backend and fontTools imported, the mathtext parser built and the fonts
-    loaded, which every figure job paid on its first save. Writes no file; the bytes
-    of a figure saved afterwards are those of a cold process (tests/test_figures.py).
-    """
-    import io
-
-    with mpl.rc_context(STYLE):
-        fig = Figure(figsize=(2.0, 1.5), layout="constrained")
-        ax = fig.add_subplot()
-        ax.loglog([1.0, 100.0], [1.0, 2.0], label=r"$\Delta = C\,F_m^{-1/6}$")
-        ax.set(xlabel=r"$F_m$ (N)", ylabel=r"$|\Delta|$ ($\mu$s)", title="warm-up")
-        ax.legend()
-        fig.savefig(io.BytesIO(), format="pdf", metadata=PDF_METADATA)
-        fig.savefig(io.BytesIO(), format="png", metadata=PNG_METADATA, dpi=PNG_DPI)
-
-
 def save_figure(fig: Figure, path: str | os.PathLike, *, processes: int = 1) -> list[Path]:
     """Write ``fig`` as ``<path>.pdf`` and ``<path>.png`` with fixed metadata.
 
