@@ -342,6 +342,10 @@ def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path,
         loads[name] = len(calls)
     assert loads == {"figure": 0, "closed_forms": 0, "fields": 1, "shots": 1}
     assert "chain.physics.kernels" in sys.modules
+    # Asked again for each job: a run's later jobs get what its first ones compiled.
+    calls.clear()
+    preload.load_kernels_for(str(tmp_path / "shots.py"))
+    assert calls == ["load"]
 
 
 def test_the_preload_imports_the_preamble_first_and_ends_ready(capsys):

@@ -163,18 +163,6 @@ def _targets(root: Path, module: str, names: list[str]) -> list[Path]:
     return files
 
 
-def imported_packages(path: str | os.PathLike) -> set[str]:
-    """The top-level packages a source file imports anywhere in it (``numba`` for
-    ``from numba.core import types``), read as for :func:`script_sources`.
-
-    Parameters
-    ----------
-    path : path
-        A Python source file.
-    """
-    return {module.split(".")[0] for module, _ in _imported_names(Path(path)) if module}
-
-
 def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) -> list[str]:
     """Source files a workflow script runs, besides itself: its local helpers and the
     package files it imports, transitively.
@@ -193,14 +181,45 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
         checkout names the same inputs).
     """
     script, root = Path(script).resolve(), Path(package_dir).resolve()
-    files: set[Path] = set()
-    for module, names in _imported_names(script):
-        if module in TRANSPORT:
-            continue
-        local = script.parent / f"{module}.py"
-        if local.is_file():
-            files.add(local)
-        for target in _targets(root, module, names):
-            files |= _package_closure(root, target)
+    files = {script.parent / f"{m}.py" for m, _ in _script_imports(script)}
+    files = {f for f in files if f.is_file()} | _package_files_run_by(script, root)
     here = Path.cwd().resolve()
     return sorted(os.path.relpath(path, here) for path in files)
+
+
+def script_modules(script: str | os.PathLike, package_dir: str | os.PathLike) -> dict:
+    """The package modules a workflow script runs (as :func:`script_sources` follows
+    them), each with the top-level packages it imports anywhere in its file.
+
+    Parameters
+    ----------
+    script : path
+        The script (or Snakemake's copy of it, with its preamble).
+    package_dir : path
+        The ``chain`` package folder the jobs import (``src/chain``).
+
+    Returns
+    -------
+    dict of str to set of str
+        Dotted module name (``chain.physics.kernels``) -> imported top-level packages
+        (``{"numba", "numpy", "chain"}``).
+    """
+    files = _package_files_run_by(Path(script).resolve(), Path(package_dir).resolve())
+    return {
+        _module_name(path): {module.split(".")[0] for module, _ in _imported_names(path) if module}
+        for path in files
+    }
+
+
+def _script_imports(script: Path) -> list[tuple[str, list[str]]]:
+    """The script's import statements, its transport helpers left out."""
+    return [(m, names) for m, names in _imported_names(script) if m not in TRANSPORT]
+
+
+def _package_files_run_by(script: Path, root: Path) -> set[Path]:
+    """Every file of the package under ``root`` that ``script`` runs, transitively."""
+    files: set[Path] = set()
+    for module, names in _script_imports(script):
+        for target in _targets(root, module, names):
+            files |= _package_closure(root, target)
+    return files

@@ -117,26 +117,22 @@ def load_kernels_for(script: str) -> None:
 
 def _kernel_modules_run_by(script: Path) -> list[str]:
     """The modules of :data:`KERNEL_PACKAGE` that import numba and that ``script``
-    runs: through every package module it imports, followed as for its code inputs
-    (:func:`chain.pipeline.deps.script_sources`). A script that imports the package's
-    closed forms (Fig. 4) or a study that simulates (through ``chain.apparatus``)
-    is told apart by what it reaches, not by what it names."""
-    from chain.pipeline.deps import imported_packages, script_sources
+    runs, through every package module it imports, followed as for its code inputs
+    (:func:`chain.pipeline.deps.script_modules`): a script that imports the closed forms
+    (Fig. 4) or one that simulates through ``chain.apparatus`` is told apart by what it
+    reaches, not by what it names."""
+    from chain.pipeline.deps import script_modules
 
     package = Path(importlib.util.find_spec(PACKAGE).origin).parent
     try:
-        sources = [(Path.cwd() / name).resolve() for name in script_sources(script, package)]
+        modules = script_modules(script, package)
     except (OSError, SyntaxError, ValueError):  # the job reports it, run as it would be
         return []
-    modules = []
-    for source in sources:
-        if not source.is_relative_to(package):
-            continue  # the script's local helpers
-        parts = source.relative_to(package.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        if name.startswith(KERNEL_PACKAGE + ".") and "numba" in imported_packages(source):
-            modules.append(name)
-    return sorted(modules)
+    return sorted(
+        name
+        for name, imports in modules.items()
+        if name.startswith(KERNEL_PACKAGE + ".") and "numba" in imports
+    )
 
 
 def _load_cached_kernels() -> int:
