@@ -26,6 +26,7 @@ from chain.pipeline.reuse import (
     software_versions,
     unhashed_wildcards,
 )
+from chain.pipeline.graceful_stop import stop_gracefully_off_the_main_thread
 from chain.pipeline.run_end import cancel_snakemake_timers
 from chain.pipeline.wakeups import coalesce_wakeups
 
@@ -227,6 +228,9 @@ ANALYSIS_JOB = {"mem_mb": 1000, "runtime": 30}
 # One pending wake-up of Snakemake's scheduler at a time, not one more per job event
 # (chain.pipeline.wakeups: Snakemake's CPU in the tiny run's 53 jobs 10.3 -> 4.5 s).
 coalesce_wakeups(JobScheduler)
+# SIGTERM (kill PID, a batch system's cancel) stops the run gracefully instead of
+# hanging it when it finds the scheduler selecting jobs (chain.pipeline.graceful_stop).
+stop_gracefully_off_the_main_thread(JobScheduler)
 
 
 # cancel_snakemake_timers: Snakemake's scheduler leaves a 1 s timer behind that the
