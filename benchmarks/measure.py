@@ -103,6 +103,61 @@ class Conditions:
         return "met" if met else "not met"
 
 
+#: Most of the machine's CPU that other processes may use during a measured command
+#: for it to count as a measurement (:class:`OtherProcesses`).
+MAX_OTHER_SHARE = 0.05
+
+
+def _machine_cpu_seconds() -> tuple[float, float]:
+    """CPU time every process of the machine used since boot (user, nice, system, irq,
+    softirq) and the time the hypervisor gave this machine's CPUs to others (steal),
+    s, from /proc/stat; NaN where there is none."""
+    try:
+        fields = Path("/proc/stat").read_text().splitlines()[0].split()[1:]
+    except (OSError, IndexError):
+        return math.nan, math.nan
+    ticks = [int(value) for value in fields] + [0] * 8
+    user, nice, system, _, _, irq, softirq, steal = ticks[:8]
+    per_second = os.sysconf("SC_CLK_TCK")
+    return (user + nice + system + irq + softirq) / per_second, steal / per_second
+
+
+def _own_cpu_seconds() -> float:
+    """CPU time of this process and of every child it (or a child of a child) waited
+    for, s."""
+    times = os.times()
+    return times.user + times.system + times.children_user + times.children_system
+
+
+@dataclass
+class OtherProcesses:
+    """The CPU other processes took while a command ran, to judge whether the command's
+    time measured it: a whole workflow loads every core itself, so the load average
+    after it says nothing of other users. Use as ``with OtherProcesses() as other:``
+    around a command whose processes this one waits for; then ``other.share`` is the
+    fraction of the machine's CPU (``cores`` x wall) the rest of the machine used,
+    steal time included, and ``other.quiet`` whether it stayed below
+    :data:`MAX_OTHER_SHARE`. A process of the command that nobody waited for counts
+    as another's: the judgement errs towards "loaded"."""
+
+    cores: int = field(default_factory=lambda: os.cpu_count() or 1)
+    share: float = math.nan
+
+    def __enter__(self):
+        self._start = (time.perf_counter(), _own_cpu_seconds(), *_machine_cpu_seconds())
+        return self
+
+    def __exit__(self, *exc) -> None:
+        wall0, own0, busy0, steal0 = self._start
+        busy1, steal1 = _machine_cpu_seconds()
+        others = (busy1 - busy0) - (_own_cpu_seconds() - own0) + (steal1 - steal0)
+        self.share = max(others, 0.0) / (self.cores * (time.perf_counter() - wall0))
+
+    @property
+    def quiet(self) -> bool:
+        return self.share <= MAX_OTHER_SHARE
+
+
 def check_repeat(repeat: int) -> int:
     """``repeat``, refused below :data:`MIN_REPEAT`."""
     if repeat < MIN_REPEAT:
