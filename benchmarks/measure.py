@@ -22,6 +22,7 @@ import os
 import platform
 import shutil
 import subprocess
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -108,25 +109,44 @@ class Conditions:
 MAX_OTHER_SHARE = 0.05
 
 
-def _machine_cpu_seconds() -> tuple[float, float]:
-    """CPU time every process of the machine used since boot (user, nice, system, irq,
-    softirq) and the time the hypervisor gave this machine's CPUs to others (steal),
-    s, from /proc/stat; NaN where there is none."""
+_TICK_S = 1.0 / os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 0.01
+
+
+def _steal_seconds() -> float:
+    """Time the hypervisor gave this machine's CPUs to other machines since boot, s
+    (/proc/stat; NaN where there is none)."""
     try:
-        fields = Path("/proc/stat").read_text().splitlines()[0].split()[1:]
-    except (OSError, IndexError):
-        return math.nan, math.nan
-    ticks = [int(value) for value in fields] + [0] * 8
-    user, nice, system, _, _, irq, softirq, steal = ticks[:8]
-    per_second = os.sysconf("SC_CLK_TCK")
-    return (user + nice + system + irq + softirq) / per_second, steal / per_second
+        fields = Path("/proc/stat").read_text().splitlines()[0].split()
+        return int(fields[8]) * _TICK_S
+    except (OSError, IndexError, ValueError):
+        return math.nan
 
 
-def _own_cpu_seconds() -> float:
-    """CPU time of this process and of every child it (or a child of a child) waited
-    for, s."""
-    times = os.times()
-    return times.user + times.system + times.children_user + times.children_system
+def _processes() -> dict[int, tuple[int, float, float]]:
+    """Every process now: pid -> (parent pid, CPU time used (user + system) s, start
+    time s after boot), from /proc/<pid>/stat."""
+    table = {}
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            text = Path(entry.path, "stat").read_text()
+        except OSError:  # gone since the listing
+            continue
+        fields = text[text.rindex(")") + 2 :].split()  # after "pid (comm) "
+        cpu = (int(fields[11]) + int(fields[12])) * _TICK_S
+        table[int(entry.name)] = (int(fields[1]), cpu, int(fields[19]) * _TICK_S)
+    return table
+
+
+def _descends_from(pid: int, root: int, table: dict) -> bool:
+    seen = set()
+    while pid not in seen and pid > 1:
+        if pid == root:
+            return True
+        seen.add(pid)
+        pid = table.get(pid, (0,))[0]
+    return False
 
 
 @dataclass
@@ -134,24 +154,55 @@ class OtherProcesses:
     """The CPU other processes took while a command ran, to judge whether the command's
     time measured it: a whole workflow loads every core itself, so the load average
     after it says nothing of other users. Use as ``with OtherProcesses() as other:``
-    around a command whose processes this one waits for; then ``other.share`` is the
-    fraction of the machine's CPU (``cores`` x wall) the rest of the machine used,
-    steal time included, and ``other.quiet`` whether it stayed below
-    :data:`MAX_OTHER_SHARE`. A process of the command that nobody waited for counts
-    as another's: the judgement errs towards "loaded"."""
+    around a command that this process starts; then ``other.share`` is the fraction of
+    the machine's CPU (``cores`` x wall) that processes not descended from this one
+    used, steal time included, and ``other.quiet`` whether it stayed below
+    :data:`MAX_OTHER_SHARE`. The processes are read every ``interval`` s (/proc): a
+    process of another user is counted from when it started or the measurement did;
+    what one used in its last ``interval`` before it exited is missed, and so is a
+    process of ours whose parent exited before it was seen (it counts as another's:
+    the judgement errs towards "loaded"). Where there is no /proc, ``share`` is NaN and
+    nothing is quiet."""
 
     cores: int = field(default_factory=lambda: os.cpu_count() or 1)
+    interval: float = 0.5
     share: float = math.nan
 
     def __enter__(self):
-        self._start = (time.perf_counter(), _own_cpu_seconds(), *_machine_cpu_seconds())
+        self._wall0, self._steal0 = time.perf_counter(), _steal_seconds()
+        self._boot_s = time.clock_gettime(time.CLOCK_BOOTTIME)
+        self._first, self._last = {}, {}  # another's pid -> CPU s when first, last seen
+        self._sample(at_start=True)
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._watch, daemon=True)
+        self._thread.start()
         return self
 
+    def _watch(self) -> None:
+        while not self._done.wait(self.interval):
+            self._sample()
+
+    def _sample(self, at_start: bool = False) -> None:
+        try:
+            table = _processes()
+        except OSError:
+            return
+        me = os.getpid()
+        for pid, (_, cpu, started) in table.items():
+            if pid in self._first:
+                self._last[pid] = cpu
+            elif not _descends_from(pid, me, table):
+                # Started before the measurement: count from now; after: all of it.
+                self._first[pid] = cpu if at_start or started < self._boot_s else 0.0
+                self._last[pid] = cpu
+
     def __exit__(self, *exc) -> None:
-        wall0, own0, busy0, steal0 = self._start
-        busy1, steal1 = _machine_cpu_seconds()
-        others = (busy1 - busy0) - (_own_cpu_seconds() - own0) + (steal1 - steal0)
-        self.share = max(others, 0.0) / (self.cores * (time.perf_counter() - wall0))
+        self._done.set()
+        self._thread.join()
+        self._sample()
+        used = sum(self._last[pid] - self._first[pid] for pid in self._first)
+        used += _steal_seconds() - self._steal0
+        self.share = max(used, 0.0) / (self.cores * (time.perf_counter() - self._wall0))
 
     @property
     def quiet(self) -> bool:
