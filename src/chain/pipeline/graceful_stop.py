@@ -43,8 +43,9 @@ def stop_gracefully_off_the_main_thread(scheduler_class) -> bool:
     Returns
     -------
     bool
-        Whether it was changed: False when the class has no such method (another
-        Snakemake version), which is then left as it is.
+        Whether the handler now runs off the main thread (patched by this call or an
+        earlier one): False when the class has no such method (another Snakemake
+        version), which is then left as it is.
     """
     handler = getattr(scheduler_class, SNAKEMAKE_METHOD, None)
     if not callable(handler) or getattr(handler, "_off_the_main_thread", False):
