@@ -351,8 +351,8 @@ def test_a_job_that_integrates_has_the_kernels_loaded_before_it_starts(tmp_path,
 def test_the_preload_imports_the_preamble_first_and_ends_ready(capsys):
     """The workflow's own preload, step by step as the server runs it: Snakemake's
     preamble's imports first (every job's process runs them before its script), then
-    the scripts' imports, what the library defers to its functions, the figures'
-    warm-up in its three steps (the scripts draw figures) and the ready line last."""
+    the scripts' imports, the figures' warm-up in its three steps (the scripts draw
+    figures) and the ready line last."""
     from chain.pipeline import preload
 
     names, preamble = [], []
@@ -365,32 +365,44 @@ def test_the_preload_imports_the_preamble_first_and_ends_ready(capsys):
     assert names[-4:] == ["warm_up", "warm_up", "warm_up", "ready"]
     assert set(names[:-4]) == {"step"}
     assert capsys.readouterr().out == "job server: ready at address\n"  # nothing failed
-    assert "scipy.signal" in sys.modules  # deferred by chain.analysis.pulses
-    assert preload.deferred_imports(sys.modules) == []
 
 
-def test_the_preload_takes_the_deferred_imports_of_loaded_packages_only(tmp_path):
-    """A module of the library that imports inside a function: the server preloads the
-    submodule of a package that is loaded (scipy.signal), not what is loaded already,
-    nor a module of a package nothing loaded (lammps, an extra that starts MPI), nor
-    what a module outside the library defers."""
-    from types import SimpleNamespace
+def test_the_server_loads_what_the_library_defers_from_a_scripts_second_job(tmp_path):
+    """chain.analysis.pulses imports scipy.signal inside find_pulses: the first job of
+    a script that reaches it is forked without it (it imports what it calls itself),
+    the second with it loaded (in a fresh interpreter, as the server is)."""
+    script = (ROOT / "workflow" / "scripts" / "pulses.py").read_text()
+    first, second = tmp_path / "tmp1a.pulses.py", tmp_path / "tmp2b.pulses.py"
+    first.write_text(script)
+    second.write_text(script)
+    check = (
+        "import sys, scipy\n"
+        "from chain.pipeline import preload\n"
+        f"preload.load_deferred_imports_for({str(first)!r})\n"
+        "print('scipy.signal' in sys.modules)\n"
+        f"preload.load_deferred_imports_for({str(second)!r})\n"
+        "print('scipy.signal' in sys.modules)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", check], capture_output=True, text=True, cwd=ROOT, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "True"]
 
+
+def test_deferred_imports_are_those_in_functions_of_loaded_packages(tmp_path):
+    """What a file imports inside a function, not at its top; of a package loaded
+    (scipy), not of one nothing loaded (lammps, an extra that starts MPI); not what is
+    loaded already (json)."""
     from chain.pipeline.preload import deferred_imports
 
-    def module(name: str, source: str) -> SimpleNamespace:
-        path = tmp_path / f"{name}.py"
-        path.write_text(source)
-        return SimpleNamespace(__file__=str(path))
-
-    deferring = "import os\n\ndef f():\n    from scipy.signal import find_peaks\n"
-    deferring += "    import lammps\n    import json\n    import scipy.optimize\n"
-    loaded = {
-        "chain.analysis.fake": module("fake", deferring),
-        "chain": SimpleNamespace(__file__=None),  # a namespace: no file
-        "other": module("other", "def f():\n    import scipy.ndimage\n"),
-        "scipy": SimpleNamespace(),
-        "scipy.optimize": SimpleNamespace(),
-        "json": SimpleNamespace(),
-    }
-    assert deferred_imports(loaded) == ["scipy.signal"]
+    module = tmp_path / "fake.py"
+    module.write_text(
+        "import scipy.optimize\n\n\ndef f():\n    from scipy.signal import find_peaks\n"
+        "    import lammps\n    import json\n\n\nclass A:\n"
+        "    def g(self):\n        import scipy.ndimage\n"
+    )
+    loaded = {"scipy", "json"}
+    assert deferred_imports([module], loaded) == ["scipy.ndimage", "scipy.signal"]
+    assert deferred_imports([module], loaded | {"scipy.signal"}) == ["scipy.ndimage"]
+    assert deferred_imports([tmp_path / "missing.py"], loaded) == []

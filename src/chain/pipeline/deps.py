@@ -211,19 +211,6 @@ def script_modules(script: str | os.PathLike, package_dir: str | os.PathLike) ->
     }
 
 
-def imported_modules(path: str | os.PathLike) -> list[str]:
-    """Dotted names of the modules the Python file ``path`` imports, anywhere in it
-    (inside functions too; relative imports made absolute for files of the package), in
-    the order of its import statements.
-
-    Parameters
-    ----------
-    path : path
-        A Python source file.
-    """
-    return [module for module, _ in _imported_names(Path(path)) if module]
-
-
 def _script_imports(script: Path) -> list[tuple[str, list[str]]]:
     """The script's import statements, its transport helpers left out."""
     return [(m, names) for m, names in _imported_names(script) if m not in TRANSPORT]

@@ -41,7 +41,7 @@ import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-from chain.pipeline.preload import load_kernels_for, preload_steps
+from chain.pipeline.preload import load_deferred_imports_for, load_kernels_for, preload_steps
 
 #: Environment variable: the server's address (set by :func:`publish` for the jobs), or
 #: ``off`` to run every job in its own process.
@@ -213,15 +213,17 @@ def stop(server: Server | None) -> None:
 def serve(address: str, scripts: Path) -> None:
     """The server's main loop: listen at ``address``, fork a child per job until the
     parent (Snakemake) is gone or a SIGTERM or SIGINT arrives (then it exits at once),
-    and meanwhile import what the ``scripts`` import; load numba's cached kernels before
-    each job that integrates.
+    and meanwhile import what the ``scripts`` import; before each job, load what it
+    needs that the library defers (imports in functions, numba's cached kernels).
 
     The imports run one module at a time, between jobs: a job that arrives first is
     forked at once, with what is imported so far, and imports the rest itself, as it
-    would in its own process; one that integrates has the kernels loaded first
-    (:func:`chain.pipeline.preload.load_kernels_for`). A run of a few jobs (a figure
-    what-if) does not wait for the whole preload (~3 s) before its first job; a long
-    run soon has it all.
+    would in its own process; what the library it runs imports inside its functions
+    is imported first, once for all later jobs
+    (:func:`chain.pipeline.preload.load_deferred_imports_for`), and for one that
+    integrates the kernels are loaded (:func:`chain.pipeline.preload.load_kernels_for`).
+    A run of a few jobs (a figure what-if) does not wait for the whole preload (~3 s)
+    before its first job; a long run soon has it all.
 
     Parameters
     ----------
@@ -259,6 +261,7 @@ def serve(address: str, scripts: Path) -> None:
         except Exception:  # a client gone or garbled: no pid, so it runs the job itself
             connection.close()
             continue
+        load_deferred_imports_for(request["script"])
         load_kernels_for(request["script"])
         if os.fork() == 0:
             listener.close()

