@@ -172,15 +172,8 @@ def _imported_in_functions(path: str) -> tuple[str, ...]:
         tree = ast.parse(text, filename=path)
     except (OSError, SyntaxError, ValueError):
         return ()
-    names: list[str] = []
     functions = (n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef))
-    for function in functions:
-        for node in ast.walk(function):
-            if isinstance(node, ast.Import):
-                names += [alias.name for alias in node.names]
-            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
-                names.append(node.module)
-    return tuple(dict.fromkeys(names))
+    return tuple(dict.fromkeys(_modules_imported_by(n for f in functions for n in ast.walk(f))))
 
 
 def load_kernels_for(script: str) -> None:
@@ -297,10 +290,14 @@ def _script_imports(path: Path) -> set[str]:
         body = ast.parse(path.read_text(), filename=str(path)).body
     except (SyntaxError, ValueError, OSError):
         return set()
-    modules: set[str] = set()
-    for node in body:
+    return set(_modules_imported_by(body))
+
+
+def _modules_imported_by(nodes: Iterable[ast.AST]) -> Iterator[str]:
+    """The modules that the import statements among ``nodes`` name (absolute imports
+    only: a relative one is the package's own, followed by chain.pipeline.deps)."""
+    for node in nodes:
         if isinstance(node, ast.Import):
-            modules.update(alias.name for alias in node.names)
+            yield from (alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
-            modules.add(node.module)
-    return modules
+            yield node.module
