@@ -14,6 +14,10 @@ It prints, for one collision in the paper's chain (N = 26, +V0 / -V0 at V0 = 0.3
    with ``cc -O3 -march=native``; skipped with a message when there is no compiler)
    at the same step; also ``integrate`` (the lean kernel behind it) and the general
    reference kernel against C; elastic and Kuwabara-Kono;
+   then (1b) the lean kernel carrying walls of zero stiffness, and a negligible track
+   friction, against itself without them: what a term costs when numba compiles it in
+   (reported, no target; 7.1 and 3.3 before 27 Nov 2026, when these terms cost
+   reference-count updates at every right-hand side);
 2. **DOP853 / kernel**: scipy ``solve_ivp(method="DOP853")`` on a numba right-hand
    side, at the loosest rtol of a fine grid (8 per decade) that reaches both the
    kernel's energy drift and its force error against a reference solution; reported,
@@ -217,9 +221,10 @@ def kernel_against_c(args, c_function) -> dict:
     return results
 
 
-def kernel_alone(module, model, velocity, dt: float, n_steps: int, every: int):
-    """A launch through ``module``'s kernel, called directly (outputs allocated)."""
-    params = _lean_params(model)
+def kernel_alone(module, model, velocity, dt: float, n_steps: int, every: int, params=None):
+    """A launch through ``module``'s kernel, called directly (outputs allocated), with
+    the model's kernel arrays or ``params``."""
+    params = _lean_params(model) if params is None else params
     n = model.n_particles
     links, particles = np.arange(n - 1), np.arange(n)
 
@@ -229,6 +234,39 @@ def kernel_alone(module, model, velocity, dt: float, n_steps: int, every: int):
         module._integrate_one(u, v, params, dt, n_steps, every, links, particles, outputs)
 
     return run
+
+
+def optional_terms(args) -> dict:
+    """Section 1b: the lean kernel carrying walls of zero stiffness, and a track friction
+    too weak to matter (1e-12 /s), against the kernel without them, on the elastic
+    collision of section 1: what a term costs when numba compiles it in (the walls
+    leave the bits unchanged). Returns {term: ratio}."""
+    model = uniform_chain(N_BEADS)
+    velocity = launch_velocities(model, SPEED, SPEED)[0]
+    dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, SPEED))
+    every = round(RECORD_INTERVAL / dt)
+    n_steps = math.ceil(DURATION / dt - 1e-9)
+    base = _lean_params(model)
+    rate = np.full(model.n_particles, 1e-12)
+    drag = np.ascontiguousarray(np.stack([rate, model.masses * rate], axis=1))
+    variants = {
+        "without": base,
+        "walls": (*base[:6], (0.0, 0.0, 0.0, 0.0), *base[7:]),
+        "drag": (*base[:7], drag, *base[8:]),
+    }
+    contenders = {
+        name: kernel_alone(kernels, model, velocity, dt, n_steps, every, params)
+        for name, params in variants.items()
+    }
+    for function in contenders.values():
+        function()  # compile
+    best = best_times(contenders, args.repeat)
+    ratios = {}
+    for name, seconds in best.items():
+        ratio = seconds / best["without"]
+        ratios[name] = ratio
+        print(f"  {name:10s} {seconds * 1e3:8.2f} ms  {ratio:5.2f} x without")
+    return ratios
 
 
 def print_bound(best: dict) -> None:
@@ -460,6 +498,8 @@ def main() -> None:
         print(f"C yardstick: {how}" if c_function else f"C yardstick skipped: {how}")
         print("\n== 1. chain.simulate / C, one collision, N = 26, V0 = 0.3 m/s, 2 ms, 1 us")
         ratios = kernel_against_c(args, c_function)
+        print("\n== 1b. walls of zero stiffness, track friction of 1e-12 /s: kernel / without")
+        terms = optional_terms(args)
         print("\n== 2. DOP853 (numba right-hand side) / kernel, same accuracy (no target)")
         dop = against_dop853(args)
         print("\n== 3. batch")
@@ -474,6 +514,10 @@ def main() -> None:
         verdict = conditions.verdict(user <= 1.3)
         print(f"chain.simulate / C ({label}): {user:.2f}  (target <= 1.3: {verdict})")
         print(f"  integrate (lean kernel) / C ({label}): {kernel:.2f}")
+    print(
+        f"kernel with walls / without: {terms['walls']:.2f}, with track friction / without: "
+        f"{terms['drag']:.2f}  (reported, no target)"
+    )
     print(f"DOP853 / kernel: {dop:.1f}  (reported, no target)")
     if not args.skip_long:
         seconds, megabytes = long["simulate_cpu_s"], long["peak_mb"]

@@ -60,7 +60,7 @@ def _lean_params(model: ChainModel) -> tuple:
     drag = np.stack([model.drag_rate, model.masses * model.drag_rate], axis=1)
     # None when absent, so that numba compiles a kernel without them.
     # (array.any(): numpy's np.any wrapper costs more than the test on a short chain)
-    walls = np.ascontiguousarray(walls) if (model.wall_stiffness > 0).any() else None
+    walls = tuple(map(float, walls.ravel())) if (model.wall_stiffness > 0).any() else None
     drag = np.ascontiguousarray(drag) if (model.drag_rate > 0).any() else None
     damped = damping if (damping[kind == HERTZ] > 0).any() else None
     return (
