@@ -82,8 +82,9 @@ def _walls(u_first, v_first, u_last, v_last, key_left, key_right, walls):
 
 
 # Dispatch on None at compile time. Not inline="always": with numba 0.68 an inlined
-# overload made _record silently skip its energy writes; LLVM inlines these anyway
-# (measured: same speed as the code written in place).
+# overload made _record silently skip its energy writes (again on 27 Nov 2026, for
+# this one). LLVM inlines the small implementations below; _walls, called with scalars
+# only, needs no reference counts whether it is inlined or not.
 def _wall_terms(u, v, keys, walls):
     """_walls, or zeros when ``walls`` is None (decided when numba compiles)."""
 
