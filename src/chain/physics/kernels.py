@@ -35,7 +35,7 @@ import math
 import numba
 import numpy as np
 
-from chain.physics import compile_once
+from chain.physics import compile_once, kernel_cache
 from chain.physics.slopes import _hertz_force, _slopes, _wall_energy, _wall_terms
 
 #: Status codes written by the kernels.
@@ -372,3 +372,8 @@ def _integrate_part(
                 status = _NOT_FINITE
     status = _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status)
     return status, step, refined, refine, dissipated, reached
+
+
+# numba's cache does not see edits of slopes.py, which these kernels inline: checked
+# here, before any of them runs (chain.physics.kernel_cache).
+kernel_cache.forget_if_sources_changed(__name__, globals())

@@ -15,6 +15,7 @@ import math
 import numba
 import numpy as np
 
+from chain.physics import kernel_cache
 from chain.physics.kernels import _NOT_FINITE, _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
 
 
@@ -265,3 +266,8 @@ def _integrate_batch(
         out_status[b] = status
         out_fail_step[b] = step
         out_refined[b] = refined
+
+
+# numba's cache does not see edits of kernels.py, whose constants these kernels read:
+# checked here, before any of them runs (chain.physics.kernel_cache).
+kernel_cache.forget_if_sources_changed(__name__, globals())
