@@ -103,3 +103,16 @@ def test_kernels_without_a_cache_are_left_alone(tmp_path):
     helper.write_text("x = 1\n")
     assert not forget_if_sources_changed(__name__, {"uncached": uncached}, sources=[helper])
     assert not list(tmp_path.glob("**/*.sha256"))
+
+
+def test_unreadable_sources_leave_the_cache_as_numba_keeps_it(tmp_path):
+    """Sources that are not files (a zipped install): the kernels import, nothing is
+    removed and no digest is written."""
+    import numba
+
+    @numba.njit(cache=True)
+    def cached(x):
+        return x
+
+    missing = tmp_path / "no_such_source.py"
+    assert not forget_if_sources_changed(__name__, {"cached": cached}, sources=[missing])

@@ -58,7 +58,10 @@ def forget_if_sources_changed(module: str, namespace: dict, sources: Iterable | 
     """
     here = Path(__file__).parent
     files = [here / s for s in SOURCES] if sources is None else list(sources)
-    current = sources_digest(files)
+    try:
+        current = sources_digest(files)
+    except OSError:  # sources not readable as files (an archive install): numba's own way
+        return False
     kernels = [
         value
         for value in namespace.values()
