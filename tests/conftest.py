@@ -231,15 +231,21 @@ def _shared_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @contextlib.contextmanager
-def _exclusive(lock_file: Path) -> Iterator[None]:
+def _exclusive(lock_file: Path, *, wait: bool = True) -> Iterator[bool]:
     """Hold an exclusive lock on ``lock_file`` (POSIX ``flock``, as the suite's
-    interruption tests are POSIX-only anyway): one worker at a time gets past it."""
+    interruption tests are POSIX-only anyway): one worker at a time gets past it.
+    Yields whether this worker holds it: always with ``wait``, else only if no other
+    worker did."""
     import fcntl
 
     with lock_file.open("a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
         try:
-            yield
+            fcntl.flock(handle, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        except BlockingIOError:
+            yield False
+            return
+        try:
+            yield True
         finally:
             fcntl.flock(handle, fcntl.LOCK_UN)
 
@@ -327,33 +333,80 @@ def _copy_user_numba_cache(source: Path, target: Path, cache_dir: Path) -> None:
 def compiled_kernels(tmp_path_factory) -> None:
     """numba's kernels for the kinds of model the workflow runs, compiled into the
     checkout's cache once for all workers, before a workflow run copies the library
-    (:func:`copy_library`).
+    (:func:`copy_library`); :func:`_compile_in_turns`."""
+    _compile_in_turns(_shared_folder(tmp_path_factory), _KERNEL_KINDS)
 
-    One lock per kind, taken by the workers in turn from a different kind each (worker
-    gw0 from the first, gw1 from the second, ...): two workers compile two kinds at
-    once, then each loads the other's from the cache. A kind whose cache entry was lost
-    (two workers writing numba's index of the same function at once) is compiled again
-    by the next worker that runs it, so every kind is in the cache when this returns."""
-    shared = _shared_folder(tmp_path_factory)
+
+@pytest.fixture(scope="session")
+def unit_test_kernels(tmp_path_factory) -> None:
+    """The kernels that the unit tests of the integrator run beyond the workflow's
+    (walls, track drag, the reference kernel), compiled in turns by the xdist workers
+    (:func:`_compile_in_turns`) when the first of those tests starts in each.
+
+    Without it, two workers that reached the kernel tests together met on the same
+    version: one compiled it, the other waited for it with its core idle (twice ~7 s at
+    the end of a 2-worker run; these two test files alone, 2 workers, fresh clone:
+    54.6-57.5 s before, 48.2-52.0 s with it). A serial run needs no turns: each test
+    compiles what it runs, and running one test costs one compile, not four."""
+    if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) > 1:
+        _compile_in_turns(_shared_folder(tmp_path_factory), _UNIT_TEST_KERNELS, wait=False)
+
+
+def _compile_in_turns(shared: Path, kinds: tuple, *, wait: bool = True) -> None:
+    """Run each of ``kinds`` (name, model keywords, kernel) once, which compiles it or
+    loads it from numba's cache, taking turns with the other workers.
+
+    One lock per kind. A worker takes the first kind, from its own place in the list
+    (worker gw0 from the first, gw1 from the second, ...), that no other worker holds:
+    two workers compile two kinds at once, then each loads the other's from the cache.
+    When every kind left is held by another worker, it waits for each (``wait``) or
+    returns, and a test that runs one waits for it in chain.physics.compile_once. A kind
+    whose cache entry was lost (two workers writing numba's index of the same function
+    at once) is compiled again by the next worker that runs it, so with ``wait`` every
+    kind is in the cache when this returns."""
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
     first = int(worker[2:]) if worker[2:].isdigit() else 0
-    for turn in range(len(_KERNEL_KINDS)):
-        name, kind = _KERNEL_KINDS[(first + turn) % len(_KERNEL_KINDS)]
-        with _exclusive(shared / f"kernels-{name}.lock"):
-            _run_kernel(kind)
+    pending = [kinds[(first + turn) % len(kinds)] for turn in range(len(kinds))]
+    while pending:
+        for kind in pending:
+            with _exclusive(shared / f"kernels-{kind[0]}.lock", wait=False) as mine:
+                if mine:
+                    _run_kernel(*kind[1:])
+                    pending.remove(kind)
+                    break
+        else:  # the others are compiling every kind left
+            if not wait:
+                return
+            name, model, kernel = pending.pop(0)
+            with _exclusive(shared / f"kernels-{name}.lock"):
+                _run_kernel(model, kernel)
 
 
 #: The kinds of model the workflow's jobs simulate: elastic and damped chains with no
-#: wall and no drag (the paper run's cache holds exactly these two); a unit test that
-#: needs another kind compiles it itself.
-_KERNEL_KINDS = (("elastic", {}), ("damped", {"eta": PAPER_ETA}))
+#: wall and no drag (the paper run's cache holds exactly these two).
+_KERNEL_KINDS = (("elastic", {}, "lean"), ("damped", {"eta": PAPER_ETA}, "lean"))
+
+#: What the unit tests of tests/test_integrator.py and tests/test_kernels.py compile
+#: beyond :data:`_KERNEL_KINDS`: the general kernel, and the lean kernel of a chain with
+#: walls, damped or not, and of one with track drag (worker gw0 starts with the first,
+#: gw1 with the second: the first test of tests/test_integrator.py runs it).
+_UNIT_TEST_KERNELS = (
+    ("reference", {"eta": PAPER_ETA, "right_wall": True}, "reference"),
+    ("walls-damped", {"eta": PAPER_ETA, "right_wall": True}, "lean"),
+    ("walls-elastic", {"left_wall": True}, "lean"),
+    ("drag-damped", {"eta": PAPER_ETA, "drag_rate": 30.0}, "lean"),
+)
 
 
-def _run_kernel(kind: dict) -> None:
-    """One short run of the kernel of this kind of model: numba compiles one kernel per
-    kind (Kuwabara-Kono damping, walls, track drag present or not;
+def _run_kernel(kind: dict, kernel: str = "lean") -> None:
+    """One short run of ``kernel`` on a chain of this kind: numba compiles one lean
+    kernel per kind of model (Kuwabara-Kono damping, walls, track drag present or not;
     chain.physics.slopes), which also serves a long chain whose beads at rest are
-    skipped (chain.physics.at_rest); or loads it from its cache."""
-    from chain import simulate, uniform_chain
+    skipped (chain.physics.at_rest), and one general kernel; or loads it from its cache."""
+    from chain import uniform_chain
+    from chain.physics.integrator import integrate
 
-    simulate(uniform_chain(4, **kind), [0.1], [0.1], duration=1e-5)
+    model = uniform_chain(4, **kind)
+    velocity = np.zeros(model.n_particles)
+    velocity[0] = 0.1
+    integrate(model, velocity, 1e-5, 1e-7, kernel=kernel)

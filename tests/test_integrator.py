@@ -22,6 +22,9 @@ from chain import (
 )
 from chain.physics.theory import hertz_contact_time, hertz_peak_force
 
+#: The kernels these tests run, compiled in turns by the workers (conftest.py).
+pytestmark = pytest.mark.usefixtures("unit_test_kernels")
+
 
 class ReferenceChain:
     """A plain-numpy right-hand side of the same physics, written from the paper's

@@ -17,6 +17,9 @@ from chain.physics.integrator import integrate
 from chain.physics.model import launch_velocities
 from chain.physics.simulation import default_time_step
 
+#: The kernels these tests run, compiled in turns by the workers (conftest.py).
+pytestmark = pytest.mark.usefixtures("unit_test_kernels")
+
 FIELDS = (
     "link_force",
     "wall_force",
