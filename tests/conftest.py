@@ -338,7 +338,7 @@ def compiled_kernels(tmp_path_factory) -> None:
 
 
 @pytest.fixture(scope="session")
-def unit_test_kernels(tmp_path_factory) -> None:
+def unit_test_kernels(request, tmp_path_factory) -> None:
     """The kernels that the unit tests of the integrator run beyond the workflow's
     (walls, track drag, the reference kernel), compiled in turns by the xdist workers
     (:func:`_compile_in_turns`) when the first of those tests starts in each.
@@ -346,9 +346,13 @@ def unit_test_kernels(tmp_path_factory) -> None:
     Without it, two workers that reached the kernel tests together met on the same
     version: one compiled it, the other waited for it with its core idle (twice ~7 s at
     the end of a 2-worker run; these two test files alone, 2 workers, fresh clone:
-    54.6-57.5 s before, 48.2-52.0 s with it). A serial run needs no turns: each test
-    compiles what it runs, and running one test costs one compile, not four."""
-    if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) > 1:
+    54.6-57.5 s before, 48.2-52.0 s with it). Only where it pays: with more than one
+    worker and a session that runs more of these tests than twice the kernels. A
+    serial run, or a few tests picked (after an edit of the kernels, whose cache it
+    empties), compile what they run: one or two kernels, not four."""
+    users = sum("unit_test_kernels" in item.fixturenames for item in request.session.items)
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    if workers > 1 and users > 2 * len(_UNIT_TEST_KERNELS):
         _compile_in_turns(_shared_folder(tmp_path_factory), _UNIT_TEST_KERNELS, wait=False)
 
 
