@@ -47,7 +47,5 @@ include: "workflow/rules/ablation.smk"
 include: "workflow/rules/mechanisms.smk"
 
 
-# After every rule: no cached rule may share one result between two of its jobs.
-check_reused_rules(workflow.rules)
 # The import statements every rule's code() read, for the next command (common.smk).
 save_imports(IMPORTS_STORE)

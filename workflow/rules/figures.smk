@@ -10,7 +10,6 @@ rule fig1_setup:
         **figure_outputs("fig1_setup"),
     log:
         f"{LOGS}/figures/fig1_setup.log",
-    cache: REUSE
     conda:
         ENV
     params:
@@ -18,7 +17,6 @@ rule fig1_setup:
         radius_m=config["radius_m"],
         material=config["material"],
         striker_radius_m=config["setup"]["striker_radius_m"],
-        software=SOFTWARE,
     script:
         "../scripts/fig1_setup.py"
 
@@ -34,7 +32,6 @@ rule fig2_experiment_traces:
         **figure_outputs("fig2_experiment_traces"),
     log:
         f"{LOGS}/figures/fig2_experiment_traces.log",
-    cache: REUSE
     conda:
         ENV
     params:
@@ -42,7 +39,6 @@ rule fig2_experiment_traces:
         or config["figures"]["representative_force_N"],
         estimator=config["analysis"]["main_estimator"],
         label=experiment_label,
-        software=SOFTWARE,
     script:
         "../scripts/fig2_experiment_traces.py"
 
@@ -60,7 +56,6 @@ rule fig3_simulation_traces:
         **figure_outputs("fig3_simulation_traces"),
     log:
         f"{LOGS}/figures/fig3_simulation_traces.log",
-    cache: REUSE
     conda:
         ENV
     params:
@@ -69,7 +64,6 @@ rule fig3_simulation_traces:
         representative_index=config["figures"]["representative_index"],
         estimator=config["analysis"]["main_estimator"],
         label="simulation",
-        software=SOFTWARE,
     script:
         "../scripts/fig3_simulation_traces.py"
 
@@ -83,7 +77,6 @@ rule fig4_delay_vs_force:
         **figure_outputs("fig4_delay_vs_force"),
     log:
         f"{LOGS}/figures/fig4_delay_vs_force.log",
-    cache: REUSE
     conda:
         ENV
     params:
@@ -91,7 +84,6 @@ rule fig4_delay_vs_force:
         radius_m=config["radius_m"],
         estimator=config["analysis"]["main_estimator"],
         experiment_label=experiment_label,
-        software=SOFTWARE,
     script:
         "../scripts/fig4_delay_vs_force.py"
 
@@ -107,7 +99,6 @@ rule fig5_ssw_vs_force:
         **figure_outputs("fig5_ssw_vs_force"),
     log:
         f"{LOGS}/figures/fig5_ssw_vs_force.log",
-    cache: REUSE
     # The figure at the end of the longest chain of tables (ssw, ssw_fits) and the
     # longest that waits for it: an analysis what-if started it after the shorter
     # figures that were ready at the same time, and ended with it running alone.
@@ -117,7 +108,6 @@ rule fig5_ssw_vs_force:
     params:
         experiment_label=experiment_label,
         sensors={n: list(s) for n, s in PLAN.chains.items()},
-        software=SOFTWARE,
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -130,12 +120,10 @@ rule fig_parity_ssw_vs_N:
         **figure_outputs("fig_parity_ssw_vs_N"),
     log:
         f"{LOGS}/figures/fig_parity_ssw_vs_N.log",
-    cache: REUSE
     conda:
         ENV
     params:
         experiment_label=experiment_label,
-        software=SOFTWARE,
     script:
         "../scripts/fig_parity_ssw_vs_N.py"
 
@@ -160,7 +148,6 @@ rule ssw_spacetime:
         **figure_outputs("ssw_spacetime"),
     log:
         f"{LOGS}/figures/ssw_spacetime.log",
-    cache: REUSE
     # The longest figure: started as soon as its inputs exist, not after the others.
     priority: 1
     conda:
@@ -173,7 +160,6 @@ rule ssw_spacetime:
         model=SPACETIME_MODEL,
         chains=list(PLAN.traces_n),
         long_chains=list(PLAN.long_chains),
-        software=SOFTWARE,
     script:
         "../scripts/fig_ssw_spacetime.py"
 
@@ -186,10 +172,7 @@ rule fig_c_sensitivity:
         **figure_outputs("fig_c_sensitivity"),
     log:
         f"{LOGS}/figures/fig_c_sensitivity.log",
-    cache: REUSE
     conda:
         ENV
-    params:
-        software=SOFTWARE,
     script:
         "../scripts/fig_c_sensitivity.py"

@@ -26,13 +26,11 @@ rule lammps_check:
         f"{OUT}/lammps/check_every_estimator.csv",
     log:
         f"{LOGS}/lammps/check.log",
-    cache: REUSE
     conda:
         ENV
     params:
         config=MECHANISM_CONFIG,
         estimators=config["analysis"]["estimators"],
-        software=SOFTWARE,
     script:
         "../scripts/lammps_check.py"
 
@@ -45,13 +43,11 @@ rule lammps_check_table:
         f"{TABLES}/lammps_check.csv",
     log:
         f"{LOGS}/tables/lammps_check.log",
-    cache: REUSE
     conda:
         ENV
     params:
         column="estimator",
         estimator=config["analysis"]["main_estimator"],
-        software=SOFTWARE,
     script:
         "../scripts/main_estimator_rows.py"
 
@@ -66,16 +62,12 @@ rule lammps_setting:
         ssw_fits=f"{OUT}/lammps/{{setting}}_N{{N}}_ssw_fits.csv",
     log:
         f"{LOGS}/lammps/{{setting}}_N{{N}}.log",
-    cache: REUSE
     conda:
         ENV
     params:
         config=MECHANISM_CONFIG,
         sensors=lambda wildcards: list(PLAN.chains[int(wildcards.N)]),
         estimators=config["analysis"]["estimators"],
-        software=SOFTWARE,
-        N=restate("N"),
-        setting=restate("setting"),
     script:
         "../scripts/lammps_setting.py"
 
@@ -105,7 +97,6 @@ rule ssw_mechanisms:
         f"{LOGS}/tables/ssw_mechanisms{{which}}.log",
     wildcard_constraints:
         which="|_all",
-    cache: REUSE
     conda:
         ENV
     params:
@@ -120,8 +111,6 @@ rule ssw_mechanisms:
         candidates=lambda wildcards: candidates_of(wildcards.which),
         candidate_reference=CANDIDATE_REFERENCE,
         estimator=config["analysis"]["main_estimator"],
-        software=SOFTWARE,
-        which=restate("which"),
     script:
         "../scripts/ssw_mechanisms.py"
 
@@ -134,10 +123,7 @@ rule fig_ssw_mechanisms:
         **figure_outputs("fig_ssw_mechanisms"),
     log:
         f"{LOGS}/figures/fig_ssw_mechanisms.log",
-    cache: REUSE
     conda:
         ENV
-    params:
-        software=SOFTWARE,
     script:
         "../scripts/fig_ssw_mechanisms.py"

@@ -16,7 +16,7 @@ rule summary:
         ssw=f"{TABLES}/ssw.csv",
         ssw_speed=f"{TABLES}/ssw_speed.csv",
         selection=selection_files,
-        runs=runs_files(),
+        runs=[f"{OUT}/simulation/{m}_N{n}_runs.csv" for _, m, n in SIMULATION_PARTS],
         lib=code("summary"),
     output:
         json=f"{OUT}/summary.json",

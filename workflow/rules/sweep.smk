@@ -17,13 +17,11 @@ rule sweep_table:
         ),
     log:
         f"{LOGS}/tables/sweep.log",
-    cache: REUSE
     conda:
         ENV
     params:
         eta_s=PLAN.models,
         estimator=config["analysis"]["main_estimator"],
-        software=SOFTWARE,
     script:
         "../scripts/sweep_table.py"
 
@@ -36,10 +34,7 @@ rule fig_c_vs_N:
         **figure_outputs("fig_c_vs_N"),
     log:
         f"{LOGS}/figures/fig_c_vs_N.log",
-    cache: REUSE
     conda:
         ENV
-    params:
-        software=SOFTWARE,
     script:
         "../scripts/fig_c_vs_N.py"

@@ -1,16 +1,22 @@
-"""First import of every script: hand the job to the workflow's job server, if one is
-up, before the script imports anything heavy (chain.pipeline.job_server).
+"""First import of every script: the job takes its result from the store if one is
+stored, else computes it (in the workflow's job server if one is up and shares the
+job's environment, else here) and stores it; then the process exits with the job's
+status (chain.pipeline.reuse.run_job, chain.pipeline.job_server.run).
 
-Importing this module runs the job in the server and exits with its status; without a
-server (a cluster job, ``HERTZCHAIN_JOB_SERVER=off``), or in the server, it does
-nothing and the script goes on here, in a process that skips the final garbage
-collections when it exits (chain.pipeline.run_end.freeze_at_exit: 0.4-0.5 s less for
-a process that imported the job's libraries).
+The process skips the final garbage collections when it exits
+(chain.pipeline.run_end.freeze_at_exit: 0.4-0.5 s less for a job's libraries). In the
+server's child that runs a job, or where no Snakemake job runs, this does nothing.
 """
 
 import __main__
-from chain.pipeline.job_server import hand_off
+from chain.pipeline import job_server
+from chain.pipeline.reuse import Job, run_job
 from chain.pipeline.run_end import freeze_at_exit
 
-freeze_at_exit()
-hand_off(getattr(__main__, "__real_file__", None))
+if hasattr(__main__, "snakemake") and not job_server.in_server():
+    freeze_at_exit()
+    sm, script = __main__.snakemake, __main__.__real_file__
+    job = Job.of(sm.rule, sm.wildcards, sm.params, sm.input, sm.output, sm.log)
+    folder = f"results/{sm.config['run_name']}"
+    reuse = sm.config.get("reuse", True)
+    raise SystemExit(run_job(job, reuse, folder, lambda: job_server.run(script)))

@@ -18,6 +18,12 @@ child shares the server's imported modules and nothing else: each job is a separ
 process, as before, and gives the same bytes (tests/test_job_server.py and the
 workflow tests compare the two ways).
 
+Only its owner can hand it a job: it listens on a socket in a folder of its own that
+only the owner may enter (0700), checks each peer's uid (``SO_PEERCRED``) before it
+reads a byte, and takes requests as JSON, never pickle. A job whose interpreter,
+``sys.prefix`` or root file system (a container) is not the server's runs in its own
+process, in its own environment, as it would without a server.
+
 The client stays for the whole job, so Snakemake sees a job end when its work ends:
 it passes SIGINT and SIGTERM on to the child and exits with the child's status. A
 child whose client dies (SIGKILL) is stopped with SIGTERM, so its atomic writers clean
@@ -29,21 +35,21 @@ is not up), a job runs in its own process as it always did.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
-import pickle
+import shutil
 import signal
 import socket
 import struct
 import subprocess
 import sys
+import tempfile
 import time
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-from chain.pipeline.preload import load_deferred_imports_for, load_kernels_for, preload_steps
-
-#: Environment variable: the server's address (set by :func:`publish` for the jobs), or
+#: Environment variable: the server's socket (set by :func:`publish` for the jobs), or
 #: ``off`` to run every job in its own process.
 ADDRESS_VARIABLE = "HERTZCHAIN_JOB_SERVER"
 
@@ -56,7 +62,7 @@ _SERVER_LOG = 1
 #: Exit status of a child killed by a signal: the shell's convention, 128 + signal.
 _SIGNAL_BASE = 128
 
-_HEADER = struct.Struct("!Q")  # length of the pickled request
+_HEADER = struct.Struct("!Q")  # length of the JSON request
 _REQUEST_TIMEOUT = 10.0  # s: a client sends its request as soon as it has connected
 _STATUS = struct.Struct("!q")  # the child's pid, then its exit status
 
@@ -64,39 +70,65 @@ _STATUS = struct.Struct("!q")  # the child's pid, then its exit status
 # ---- the client: a job's own process --------------------------------------------------
 
 
-def hand_off(script: str | None) -> None:
-    """Run this job's ``script`` in the workflow's job server, if one is up, and exit
-    with its status; return (the caller runs the script itself) if there is none.
+def run(script: str) -> int:
+    """Run a job's ``script`` in the workflow's job server if one is up and takes it,
+    else in this process; its exit status.
 
     Parameters
     ----------
-    script : str or None
+    script : str
         The file the job's interpreter is running: Snakemake's copy of the workflow
-        script with its preamble (``__real_file__``); None, run here.
+        script with its preamble (``__real_file__``).
+    """
+    status = hand_off(script)
+    return run_script(script) if status is None else status
+
+
+def in_server() -> bool:
+    """Whether this process is a job the server runs (the client reuses and stores)."""
+    return _IN_SERVER
+
+
+def identity() -> dict:
+    """What a job must share with the server to run in it: interpreter, prefix and
+    root file system (a container's differs)."""
+    root = os.stat("/")
+    return {"executable": sys.executable, "prefix": sys.prefix, "root": [root.st_dev, root.st_ino]}
+
+
+def hand_off(script: str) -> int | None:
+    """Run ``script`` in the job server and return its exit status; None if no server
+    is up or it does not take the job (another environment): run it here.
+
+    Parameters
+    ----------
+    script : str
+        As :func:`run`'s.
     """
     address = os.environ.get(ADDRESS_VARIABLE, "off")
-    if _IN_SERVER or script is None or address == "off":
-        return
+    if _IN_SERVER or address == "off":
+        return None
     try:
         connection = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-        connection.connect(_socket_name(address))
-        request = pickle.dumps(
+        connection.connect(address)
+        request = json.dumps(
             {
                 "script": script,
                 "cwd": os.getcwd(),
                 "env": dict(os.environ),
                 "path": sys.path,
+                "identity": identity(),
                 "sent": time.time(),  # for the server's log: how long the job waited
             }
-        )
+        ).encode()
         socket.send_fds(connection, [_HEADER.pack(len(request))], [0, 1, 2])
         connection.sendall(request)
         child = _receive(connection)
     except OSError:
-        return  # no server (not up, gone): the job runs here
+        return None  # no server (not up, gone): the job runs here
     if child is None:
-        return  # the server went away before it started the job
-    raise SystemExit(_wait_for(connection, child))
+        return None  # not taken (another environment), or the server went away
+    return _wait_for(connection, child)
 
 
 def _wait_for(connection: socket.socket, child: int) -> int:
@@ -129,12 +161,6 @@ def _receive(connection: socket.socket) -> int | None:
     return _STATUS.unpack(data)[0]
 
 
-def _socket_name(address: str) -> str:
-    """The socket of ``address``: Linux's abstract namespace (no file, no path-length
-    limit, gone with the server)."""
-    return "\0" + address
-
-
 # ---- the server -----------------------------------------------------------------------
 
 
@@ -144,6 +170,11 @@ class Server:
 
     process: subprocess.Popen
     address: str
+
+    @property
+    def folder(self) -> Path:
+        """The server's private folder (0700), which holds its socket."""
+        return Path(self.address).parent
 
 
 def start(scripts: str | os.PathLike, log: str | os.PathLike) -> Server | None:
@@ -166,7 +197,11 @@ def start(scripts: str | os.PathLike, log: str | os.PathLike) -> Server | None:
     """
     if os.environ.get(ADDRESS_VARIABLE) == "off" or not sys.platform.startswith("linux"):
         return None
-    address = f"hertzchain-{os.getpid()}-{os.urandom(6).hex()}"
+    # mkdtemp's folder is 0700: no other user can reach the socket (a short path:
+    # a socket's is limited to 107 bytes).
+    runtime = os.environ.get("XDG_RUNTIME_DIR")
+    folder = tempfile.mkdtemp(prefix="hertzchain-", dir=runtime if runtime else None)
+    address = os.path.join(folder, "socket")
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as stream:
         process = subprocess.Popen(
@@ -208,6 +243,7 @@ def stop(server: Server | None) -> None:
         server.process.terminate()
         with contextlib.suppress(subprocess.TimeoutExpired):
             server.process.wait(timeout=10)
+    shutil.rmtree(server.folder, ignore_errors=True)
 
 
 def serve(address: str, scripts: Path) -> None:
@@ -228,16 +264,18 @@ def serve(address: str, scripts: Path) -> None:
     Parameters
     ----------
     address : str
-        The socket's name in Linux's abstract namespace (:data:`ADDRESS_VARIABLE`).
+        The socket's path, in a folder only its owner may enter (:func:`start`).
     scripts : Path
         The workflow's scripts folder.
     """
+    from chain.pipeline.preload import load_deferred_imports_for, load_kernels_for, preload_steps
+
     global _SERVER_LOG
     _SERVER_LOG = os.dup(1)
     parent = os.getppid()
     _die_with_parent()
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    listener.bind(_socket_name(address))
+    listener.bind(address)
     listener.listen(64)
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda signum, frame: os._exit(0))
@@ -255,10 +293,13 @@ def serve(address: str, scripts: Path) -> None:
                 preloading = False
             continue
         try:
+            _check_peer(connection)
             connection.settimeout(_REQUEST_TIMEOUT)
             request, fds = _read_request(connection)
             connection.settimeout(None)
-        except Exception:  # a client gone or garbled: no pid, so it runs the job itself
+        except Exception as refused:  # no pid: a client of ours runs the job itself
+            if isinstance(refused, PermissionError):
+                print(f"job server: refused: {refused}", flush=True)
             connection.close()
             continue
         load_deferred_imports_for(request["script"])
@@ -298,7 +339,7 @@ def _run_child(connection: socket.socket, request: dict, fds: list[int]) -> None
         _stop_when_client_dies(connection)
         waited = time.time() - request.get("sent", time.time())
         begun = time.perf_counter()
-        status = _run_script(request["script"])
+        status = run_script(request["script"])
         took = time.perf_counter() - begun
         _log(
             f"{Path(request['script']).name}: status {status}, {took:.2f} s, "
@@ -323,6 +364,17 @@ def _log(line: str) -> None:
         os.write(_SERVER_LOG, f"job server: pid {os.getpid()}: {line}\n".encode())
 
 
+def _check_peer(connection: socket.socket) -> None:
+    """Raise PermissionError unless the peer runs as this server's user (its uid, read
+    by the kernel at connect time)."""
+    credentials = struct.Struct("3i")
+    pid, uid, _ = credentials.unpack(
+        connection.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED, credentials.size)
+    )
+    if uid != os.getuid():
+        raise PermissionError(f"pid {pid} runs as uid {uid}, not as uid {os.getuid()}")
+
+
 def _read_request(connection: socket.socket) -> tuple[dict, list[int]]:
     """A client's request (script, directory, environment, import path) and its
     streams' file descriptors (stdin, stdout, stderr)."""
@@ -337,7 +389,10 @@ def _read_request(connection: socket.socket) -> tuple[dict, list[int]]:
             if not chunk:
                 raise ConnectionError("the client closed before its request was read")
             data += chunk
-        return pickle.loads(data), fds
+        request = json.loads(data)
+        if request.get("identity") != identity():
+            raise ConnectionRefusedError("another environment: the job runs in its own")
+        return request, fds
     except BaseException:
         for fd in fds:
             os.close(fd)
@@ -404,8 +459,15 @@ def _stop_when_client_dies(connection: socket.socket) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _run_script(script: str) -> int:
-    """Run ``script`` as the job's ``__main__``; its exit status, as Python's would be."""
+def run_script(script: str) -> int:
+    """Run ``script`` as this process's ``__main__``; its exit status, as Python's
+    would be.
+
+    Parameters
+    ----------
+    script : str
+        A Python file.
+    """
     import runpy
 
     try:

@@ -425,8 +425,6 @@ def figure_entries(
     texts = texts or {}
     out = []
     for path in paths:
-        # Absolute, links not followed: a figure reused across runs is a link named by
-        # its provenance hash (results/.cache), its name is the link's.
         path = Path(os.path.abspath(path))
         text = texts.get(path.stem) or figure_text(path.stem, {})
         out.append({"name": path.stem, "path": "/" + path.relative_to(root).as_posix(), **text})

@@ -1,0 +1,145 @@
+"""Two defects of Snakemake's scheduler that a run of this workflow meets, patched from
+the Snakefile until Snakemake fixes them; each is written up with a reproducer that
+needs no part of this workflow in ``docs/snakemake_defects.md``.
+
+* **Wake-ups multiply** (:func:`coalesce_wakeups`). ``JobScheduler`` ends each pass of
+  its loop in which jobs were ready with a ``threading.Timer`` that wakes the loop
+  after the job rate limiter's timespan; the pass such a timer wakes starts another,
+  and every job that starts or ends adds a pass, so the timers multiply. The tiny test
+  config's 53 jobs made 1687 passes, each re-reading the size of every ready job's
+  inputs and solving the job selection again: 10.3 s of Snakemake's CPU, 4.5 s with
+  one pending wake-up (snakemake issue #3804: with 10 000 jobs it runs out of
+  threads). The timers are not daemons, so the process also waits up to a second for
+  them after its last job.
+* **SIGTERM hangs the run** (:func:`stop_gracefully_off_the_main_thread`). The SIGTERM
+  handler ``exit_gracefully`` takes the scheduler's lock (not reentrant); Python runs
+  the handler in the main thread, which holds that lock while it selects jobs. A
+  SIGTERM in that window (``kill PID``; a batch system's cancel) makes the main thread
+  wait for itself, for good.
+
+Each patch checks that the method it replaces is there and does nothing otherwise;
+:func:`patch_snakemake` says on the console when the running Snakemake is not the one
+the patches were written for (:data:`WRITTEN_FOR`), and which behaviour is then
+Snakemake's own. ``tests/test_snakemake_patches.py`` fails when they no longer apply to
+the locked Snakemake.
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+
+#: The Snakemake release whose scheduler these patches were written for (and tested
+#: against: requirements/*.lock pin it).
+WRITTEN_FOR = "9.27.1"
+
+#: The JobScheduler methods the patches replace (sic: Snakemake's spelling).
+WAKEUP_METHOD = "_schedule_reevalutation"
+SIGTERM_METHOD = "exit_gracefully"
+
+#: What a run does without each patch (said when a patch does not apply).
+UNPATCHED = {
+    WAKEUP_METHOD: "the scheduler's wake-up timers multiply (more CPU in Snakemake's "
+    "process, up to 1 s of waiting at its exit)",
+    SIGTERM_METHOD: "a SIGTERM (kill PID, a batch system's cancel) may hang the run "
+    "while Snakemake selects jobs",
+}
+
+
+def coalesce_wakeups(scheduler_class) -> bool:
+    """Make ``scheduler_class`` (Snakemake's ``JobScheduler``) keep at most one pending
+    wake-up timer per scheduler, a daemon thread. While jobs wait, a pass still comes
+    once per timespan, which is all the rate limiter needs; the selection is unchanged.
+
+    Parameters
+    ----------
+    scheduler_class : type
+        The class whose ``_schedule_reevalutation(self, delay)`` (delay in s) starts a
+        timer that releases ``self._open_jobs``.
+
+    Returns
+    -------
+    bool
+        Whether it was changed (False: no such method, left as it is).
+    """
+    original = getattr(scheduler_class, WAKEUP_METHOD, None)
+    if not callable(original):
+        return False
+
+    @functools.wraps(original)  # keeps Snakemake's own as __wrapped__
+    def schedule_wakeup(self, delay) -> None:
+        if getattr(self, "_pending_wakeup", None) is not None:
+            return  # one is on its way: it wakes the loop within `delay`
+        timer = threading.Timer(delay, _wake, [self])
+        timer.daemon = True
+        self._pending_wakeup = timer
+        timer.start()
+
+    setattr(scheduler_class, WAKEUP_METHOD, schedule_wakeup)
+    return True
+
+
+def _wake(scheduler) -> None:
+    # Cleared before the release: the pass it wakes may start the next one.
+    scheduler._pending_wakeup = None
+    scheduler._open_jobs.release()
+
+
+def stop_gracefully_off_the_main_thread(scheduler_class) -> bool:
+    """Make ``scheduler_class`` run its SIGTERM handler in a thread of its own, which
+    waits for the lock as the executor's callback threads do; the main thread finishes
+    its pass, and the stop proceeds as Snakemake means it to (no new job, the running
+    ones finish, exit 1). Call it before the scheduler is made (it installs the handler
+    as it starts).
+
+    Parameters
+    ----------
+    scheduler_class : type
+        The class whose ``exit_gracefully(self, *args)`` is the SIGTERM handler.
+
+    Returns
+    -------
+    bool
+        Whether the handler now runs off the main thread (False: no such method).
+    """
+    handler = getattr(scheduler_class, SIGTERM_METHOD, None)
+    if not callable(handler) or getattr(handler, "_off_the_main_thread", False):
+        return callable(handler)
+
+    @functools.wraps(handler)  # keeps Snakemake's own as __wrapped__
+    def exit_gracefully(self, *args) -> None:
+        # A daemon: if the run ends before the lock is free, the process does not wait.
+        threading.Thread(
+            target=handler, args=(self, *args), name="graceful-stop", daemon=True
+        ).start()
+
+    exit_gracefully._off_the_main_thread = True
+    setattr(scheduler_class, SIGTERM_METHOD, exit_gracefully)
+    return True
+
+
+def patch_snakemake(scheduler_class, version: str) -> list[str]:
+    """Apply both patches to ``scheduler_class``; the lines to say on the console: none
+    for the Snakemake they were written for, else which behaviour is Snakemake's own.
+
+    Parameters
+    ----------
+    scheduler_class : type
+        ``snakemake.scheduling.job_scheduler.JobScheduler``.
+    version : str
+        The running Snakemake's version.
+    """
+    applied = {
+        WAKEUP_METHOD: coalesce_wakeups(scheduler_class),
+        SIGTERM_METHOD: stop_gracefully_off_the_main_thread(scheduler_class),
+    }
+    if version == WRITTEN_FOR and all(applied.values()):
+        return []
+    lines = [
+        f"hertzchain: Snakemake {version}, not {WRITTEN_FOR}, the release its two "
+        "scheduler patches were written for (docs/snakemake_defects.md):"
+    ]
+    for method, done in applied.items():
+        state = "applied, untested on this release" if done else "NOT applied"
+        lines.append(f"  {method}: {state}; without it {UNPATCHED[method]}")
+    return lines
