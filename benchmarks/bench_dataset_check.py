@@ -82,12 +82,12 @@ def best(repeat: int, work) -> float:
 
 def figures(args, size_mb: float, yardstick: float, cold_s: float, warm_s: float) -> list:
     """What this benchmark measured, for its results file."""
-    reading = f"pandas.read_csv of the {args.shots} files, same run"
+    reading = f"pandas.read_csv of the {args.shots:,} files, same run"
     parse = "parsing every file, as the yardstick does"
     rerun = "hashing every file's bytes and reading the stored verdicts"
     return [
         Figure(
-            f"yardstick: pandas.read_csv of {args.shots} shot files ({size_mb:.1f} MB)",
+            f"yardstick: pandas.read_csv of {args.shots:,} shot files ({size_mb:.1f} MB)",
             yardstick,
             "s",
             "reading and parsing the files' text",
