@@ -1,7 +1,7 @@
 """The benchmarks' figures come from the benchmarks (issue 55): each writes its results
 file under benchmarks/results/ (``measure.write_result``), and the table of
-benchmarks/README.md is generated from those files (``python benchmarks/measure.py
---table``). Nothing here runs a benchmark."""
+benchmarks/README.md is generated from those files (``python benchmarks/table.py``).
+Nothing here runs a benchmark."""
 
 from __future__ import annotations
 
@@ -18,24 +18,26 @@ BENCHMARKS = ROOT / "benchmarks"
 PENDING = {"bench_integrator.py", "kernel_breakdown.py"}
 
 
-def _measure():
-    spec = importlib.util.spec_from_file_location("bench_measure", BENCHMARKS / "measure.py")
+def _load(name: str, alias: str):
+    """benchmarks/<name>.py as the module ``alias``."""
+    spec = importlib.util.spec_from_file_location(alias, BENCHMARKS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # for its dataclasses
+    sys.modules[alias] = module  # for its dataclasses
     spec.loader.exec_module(module)
     return module
 
 
-measure = _measure()
+measure = _load("measure", "measure")  # as the benchmarks and table.py import it
+table = _load("table", "benchmarks_table")
 RESULT_FILES = sorted(measure.RESULTS.glob("*.json"))
 
 
 def test_the_readme_table_is_generated_from_the_results_files():
-    readme = measure.README.read_text(encoding="utf-8")
-    expected = measure.table(measure.read_results())
-    assert measure.readme_table(readme) == expected, (
+    readme = table.README.read_text(encoding="utf-8")
+    expected = table.table(measure.read_results())
+    assert table.readme_table(readme) == expected, (
         "benchmarks/README.md's table differs from benchmarks/results/*.json: "
-        "run  python benchmarks/measure.py --table"
+        "run  python benchmarks/table.py"
     )
 
 
@@ -85,5 +87,5 @@ def test_write_result_refuses_met_under_load(tmp_path):
     assert [f["verdict"] for f in written["figures"]] == [measure.UNDER_LOAD, "met"]
     quiet = measure.write_result("bench_x", figures, conditions, 0.01, folder=tmp_path)
     assert [f["verdict"] for f in json.loads(quiet.read_text())["figures"]] == ["met", "met"]
-    table = measure.table(measure.read_results(tmp_path))
-    assert "| bench_x | speed | 1.1 x | C | <= 1.3 | met | the steps |" in table
+    text = table.table(measure.read_results(tmp_path))
+    assert "| bench_x | speed | 1.1 x | C | <= 1.3 | met | the steps |" in text
