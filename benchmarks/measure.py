@@ -376,6 +376,15 @@ def _finite(value):
     return None if value is None or not math.isfinite(value) else value
 
 
+def _loads(conditions: Conditions) -> dict:
+    """The first and last load average read, and every reading when there were more."""
+    loads = [_finite(round(load, 2)) for load in conditions.loads] or [None]
+    readings = {"cores": conditions.cores, "before": loads[0], "after": loads[-1]}
+    if conditions.labels not in ([], ["before", "after"]):
+        readings["readings"] = dict(zip(conditions.labels, loads, strict=True))
+    return readings
+
+
 def write_result(
     benchmark: str,
     figures: list[Figure],
@@ -400,7 +409,7 @@ def write_result(
     for figure in figures:
         row = {key: getattr(figure, key) for key in FIGURE_KEYS}
         row["value"] = _finite(figure.value)
-        if row["value"] is not None:
+        if isinstance(row["value"], float):
             row["value"] = float(f"{row['value']:.4g}")
         if loaded and figure.verdict == "met" and figure.unit not in LOAD_INDEPENDENT_UNITS:
             row["verdict"] = UNDER_LOAD
@@ -413,10 +422,7 @@ def write_result(
         "commit": head,
         "dirty": dirty,
         "machine": machine_info(),
-        "load_average": {
-            "cores": conditions.cores,
-            **{label: _finite(load) for label, load in zip(conditions.labels, conditions.loads)},
-        },
+        "load_average": _loads(conditions),
         "others_cpu_share": None if others is None else _finite(round(others, 4)),
         "loaded": loaded,
         "figures": rows,

@@ -73,9 +73,8 @@ def table(results: list[dict]) -> str:
         _row(("---",) * 7),
     ]
     for result in results:
-        machine, load = result["machine"], dict(result["load_average"])
-        cores = load.pop("cores")
-        loads = ", ".join(f"{label} {_number(value)}" for label, value in load.items())
+        machine, load = result["machine"], result["load_average"]
+        loads = f"{_number(load['before'])} -> {_number(load['after'])} on {load['cores']} cores"
         share = result["others_cpu_share"]
         lines.append(
             _row(
@@ -86,7 +85,7 @@ def table(results: list[dict]) -> str:
                     (result["commit"] or "?") + (" (modified)" if result["dirty"] else ""),
                     f"{machine['cpu']}, {machine['cores']} cores; Python {machine['python']}, "
                     f"numpy {machine['numpy']}, numba {machine['numba']}",
-                    f"{loads} on {cores} cores" + (" (loaded)" if result["loaded"] else ""),
+                    loads + (" (loaded)" if result["loaded"] else ""),
                     "not measured" if share is None else f"{share:.1%}",
                 )
             )
