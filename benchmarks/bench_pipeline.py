@@ -40,7 +40,8 @@ README's test command runs once in the last copy (``--no-tests`` skips it)::
 Each scenario's jobs are counted as run (the job started) or reused (its result taken
 from results/.cache, issue 33: its log stays empty). For the paper run it also prints,
 per rule, the jobs and their summed wall time from Snakemake's own start and finish
-lines (whole seconds): what bounds the figure.
+lines (whole seconds): what bounds the figure. The best times, their ratios to the
+yardstick and their verdicts go to benchmarks/results/ (``measure.write_result``).
 """
 
 from __future__ import annotations
@@ -60,7 +61,14 @@ from pathlib import Path
 import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).parent))
-from measure import MAX_OTHER_SHARE, UNDER_LOAD, Conditions, OtherProcesses
+from measure import (
+    MAX_OTHER_SHARE,
+    UNDER_LOAD,
+    Conditions,
+    Figure,
+    OtherProcesses,
+    write_result,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -85,6 +93,16 @@ SIMULATIONS = (
 )  # fmt: skip
 #: The test suite and .ci/run, s.
 TESTS_TARGET_S = 240.0
+#: What bounds each scenario's time (benchmarks/README.md has the measurements).
+BOUNDS = {
+    "yardstick": "the baseline commit's jobs, each in its own process",
+    "paper": "CPU: numba's cold compile on the critical path, then the jobs' CPU on 2 cores",
+    "forced": "CPU: every job's work on 2 cores, nothing compiled",
+    "brass": "CPU: the new material's simulations and everything downstream",
+    "analysis": "CPU: the fits and figures downstream of the estimator, no simulation",
+    "figure": "CPU: the space-time figure's cells drawn to PDF and PNG, and the article",
+    "tests": "CPU: the suite's Snakemake runs and the kernel tests' cold compiles",
+}
 
 _STAMP = re.compile(r"^\[(\w{3} \w{3} +\d+ \d\d:\d\d:\d\d \d{4})\]$")
 _START = re.compile(r"^\s*(?:local)?rule (\w+):$")
@@ -238,30 +256,63 @@ def scaled(target, speed: float):
     return None if target is None else target / speed
 
 
-def summarise(rounds: list[dict], scale: Timed | None) -> None:
+def _target(target, stretch) -> str:
+    if target is None:
+        return ""
+    return f"<= {target:.1f} s" + ("" if stretch is None else f" (stretch <= {stretch:.1f} s)")
+
+
+def _judged(text: str) -> str:
+    """The verdicts of a printed judgement: "target <= 45.0 s: met; stretch <= 30.0 s:
+    not met" -> "met; stretch not met"."""
+    verdicts = [part.split(": ", 1)[1] for part in text.split("; ")] if text else [""]
+    return "; stretch ".join(verdicts)
+
+
+def summarise(rounds: list[dict], scale: Timed | None) -> list[Figure]:
     """The best round of each scenario against its target, and against the target
-    scaled by ``scale`` (the best yardstick run; None: none was run)."""
+    scaled by ``scale`` (the best yardstick run; None: none was run); returns them as
+    the figures of the results file."""
+    figures = []
     print(f"\nbest of {len(rounds)} interleaved round(s), --cores as given:")
     speed = BASELINE_PAPER_S / scale.wall if scale else None
+    ratio_to = f"the yardstick: {BASELINE_COMMIT}'s paper run, best round"
     if speed is not None:
         print(f"  yardstick {scale.wall:6.1f} s  ({BASELINE_COMMIT}'s paper run; "
               f"{BASELINE_PAPER_S:.0f} s on issue 33's machine: this one is "
               f"{speed:.2f} x as fast, and each target is scaled by 1/{speed:.2f})")  # fmt: skip
+        figures.append(Figure("yardstick", scale.wall, "s", BOUNDS["yardstick"]))
     for name, _, _, target, stretch in SCENARIOS:
         timed, jobs = min((r[name] for r in rounds), key=lambda pair: pair[0].wall)
         ran = sorted(set(jobs.loc[jobs["ran"], "rule"]))
         shown = ", ".join(ran) if len(ran) <= 6 else f"{len(ran)} rules"
         count = f"{len(jobs):3d} jobs, {int(jobs['ran'].sum()):3d} run"
-        print(f"  {name:9s} {timed.wall:6.1f} s  {count} ({shown})  "
-              f"{verdict(timed, target, stretch)}")  # fmt: skip
+        judged = verdict(timed, target, stretch)
+        print(f"  {name:9s} {timed.wall:6.1f} s  {count} ({shown})  {judged}")
+        label = f"{name} ({len(jobs)} jobs, {int(jobs['ran'].sum())} run)"
+        figures.append(
+            Figure(label, timed.wall, "s", BOUNDS[name], None, _target(target, stretch),
+                   _judged(judged))
+        )  # fmt: skip
         if speed is not None:
-            here = verdict(timed, scaled(target, speed), scaled(stretch, speed), scale)
+            limits = scaled(target, speed), scaled(stretch, speed)
+            here = verdict(timed, *limits, scale)
             print(f"  {'':9s} {timed.wall / scale.wall:6.3f} x the yardstick; on this "
                   f"machine {here}")  # fmt: skip
+            figures.append(
+                Figure(f"{name} / yardstick", timed.wall / scale.wall, "x", BOUNDS[name], ratio_to,
+                       _target(*limits), _judged(here))
+            )  # fmt: skip
     analysis = rounds[-1]["analysis"][1]
     simulated = analysis[analysis["ran"] & analysis["rule"].isin(SIMULATIONS)]
     print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none): "
           f"{', '.join(sorted(set(simulated['rule']))) or '-'}")  # fmt: skip
+    figures.append(
+        Figure("analysis what-if, simulation jobs run", len(simulated), "jobs",
+               "the jobs whose inputs the estimator does not change are reused", None,
+               "0", "met" if simulated.empty else "not met")
+    )  # fmt: skip
+    return figures
 
 
 def main(argv=None) -> int:
@@ -291,18 +342,33 @@ def main(argv=None) -> int:
         paper = rounds[-1]["paper"][1]
         print(per_rule(paper).to_string(float_format=lambda v: f"{v:.0f}"))
         scale = min(baseline, key=lambda timed: timed.wall) if baseline else None
-        summarise(rounds, scale)
+        figures = summarise(rounds, scale)
+        commands = baseline + [t for r in rounds for t, _ in r.values()]
         if not args.no_tests:
             conditions.sample("before the tests")
             tests = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
             timed, printed = run(tests, work)
             conditions.sample("after the tests")
             closing = printed.strip().splitlines()[-1]
-            print(f"  tests     {timed.wall:6.1f} s  ({closing})  "
-                  f"{verdict(timed, TESTS_TARGET_S, None)}")  # fmt: skip
+            judged = verdict(timed, TESTS_TARGET_S, None)
+            print(f"  tests     {timed.wall:6.1f} s  ({closing})  {judged}")
+            figures.append(
+                Figure(f"tests ({closing})", timed.wall, "s", BOUNDS["tests"], None,
+                       _target(TESTS_TARGET_S, None), _judged(judged))
+            )  # fmt: skip
+            commands.append(timed)
             if scale:
                 here = scaled(TESTS_TARGET_S, BASELINE_PAPER_S / scale.wall)
-                print(f"  {'':9s} on this machine {verdict(timed, here, None, scale)}")
+                judged = verdict(timed, here, None, scale)
+                print(f"  {'':9s} on this machine {judged}")
+                figures.append(
+                    Figure("tests / yardstick", timed.wall / scale.wall, "x", BOUNDS["tests"],
+                           f"the yardstick: {BASELINE_COMMIT}'s paper run, best round",
+                           _target(here, None), _judged(judged))
+                )  # fmt: skip
+        # Other processes' share over every timed command, weighted by its time.
+        others = sum(t.others * t.wall for t in commands) / sum(t.wall for t in commands)
+        write_result("bench_pipeline", figures, conditions, others, own_load=True)
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)

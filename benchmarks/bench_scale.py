@@ -15,7 +15,7 @@ sensor beads (at N/3 and 2N/3) and the energies. It prints the best CPU and wall
 of ``--repeat`` (>= 7) runs of ``simulate`` (after compilation), ``default_time_step``
 alone, the process's peak resident memory, and the growth of the time from one N to
 the next (10x more beads: linear growth is a ratio of 10), with the load average
-before and after.
+before and after, and writes them to benchmarks/results/ (``measure.write_result``).
 
 Targets: issue 25, 100,000 beads x 1 ms at most linear in N (growth <= ~10); issue 14,
 N = 10,000 x 5 ms in < 10 s and < 1 GB (issue 25's < 4 s and < 300 MB:
@@ -33,7 +33,15 @@ import subprocess
 import sys
 import time
 
-from measure import MIN_REPEAT, Conditions, check_repeat, peak_memory_mb
+from measure import (
+    MIN_REPEAT,
+    Conditions,
+    Figure,
+    OtherProcesses,
+    check_repeat,
+    peak_memory_mb,
+    write_result,
+)
 
 SPEED = 0.3  # m/s
 RECORD_INTERVAL = 1e-6  # s
@@ -76,6 +84,25 @@ def one(n_beads: int, duration: float, sensors_only: bool, repeat: int) -> dict:
     }
 
 
+def result_figures(figures: dict, previous: float | None, args) -> list:
+    """One N's figures for the results file: CPU time, growth over the previous N,
+    peak memory."""
+    n_beads, cpu = figures["n_beads"], figures["cpu_seconds"]
+    what = f"N = {n_beads:,} x {args.duration * 1e3:g} ms"
+    moving = "the beads the waves have reached (chain.physics.at_rest skips the others)"
+    rows = [Figure(f"{what}, CPU", cpu, "s", moving)]
+    if previous is not None:
+        rows.append(
+            Figure(f"{what}, CPU growth", cpu / previous, "x", moving,
+                   ratio_to="the previous N's CPU, same run", target="<= ~10 (linear in N)")
+        )  # fmt: skip
+    rows.append(
+        Figure(f"{what}, peak memory", figures["peak_mb"], "MB",
+               "the interpreter and numba, plus the record asked for")
+    )  # fmt: skip
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[1_000, 10_000, 100_000])
@@ -101,26 +128,34 @@ def main() -> None:
     )
     previous = None
     environment = {**os.environ, "NUMBA_NUM_THREADS": "1"}
-    for n_beads in args.sizes:
-        command = [sys.executable, __file__, "--one", str(n_beads), "--repeat", str(args.repeat)]
-        command += ["--duration", str(args.duration)] + (["--sensors"] if args.sensors else [])
-        done = subprocess.run(command, capture_output=True, text=True, check=True, env=environment)
-        figures = json.loads(done.stdout.strip().splitlines()[-1])
-        # Growth in CPU time: on a shared machine the wall time also measures the others.
-        growth = "" if previous is None else f"{figures['cpu_seconds'] / previous:.1f}"
-        previous = figures["cpu_seconds"]
-        print(
-            f"{n_beads:>8} {figures['seconds']:8.2f} {figures['cpu_seconds']:8.2f} {growth:>7} "
-            f"{figures['default_time_step_s']:12.4f} {figures['peak_mb']:8.0f} "
-            f"{figures['steps']:>7} {figures['recorded_contacts']:>8} "
-            f"{figures['energy_drift']:8.1e}"
-        )
+    measured = []
+    with OtherProcesses(interval=1.0) as others:
+        for n_beads in args.sizes:
+            command = [sys.executable, __file__, "--one", str(n_beads)]
+            command += ["--repeat", str(args.repeat), "--duration", str(args.duration)]
+            command += ["--sensors"] if args.sensors else []
+            done = subprocess.run(
+                command, capture_output=True, text=True, check=True, env=environment
+            )
+            figures = json.loads(done.stdout.strip().splitlines()[-1])
+            # Growth in CPU time: on a shared machine the wall time also measures the others.
+            growth = "" if previous is None else f"{figures['cpu_seconds'] / previous:.1f}"
+            measured += result_figures(figures, previous, args)
+            previous = figures["cpu_seconds"]
+            print(
+                f"{n_beads:>8} {figures['seconds']:8.2f} {figures['cpu_seconds']:8.2f} "
+                f"{growth:>7} {figures['default_time_step_s']:12.4f} "
+                f"{figures['peak_mb']:8.0f} {figures['steps']:>7} "
+                f"{figures['recorded_contacts']:>8} {figures['energy_drift']:8.1e}"
+            )
     conditions.sample("after")
     print(
         "target: growth <= ~10 per 10x N (at most linear; below it while the waves reach "
         "fewer beads than the chain has: chain.physics.at_rest skips the others)"
         + ("; UNDER LOAD — times not a measurement of the target" if conditions.under_load else "")
     )
+    name = "bench_scale_sensors" if args.sensors else "bench_scale"
+    write_result(name, measured, conditions, others.share)
 
 
 if __name__ == "__main__":

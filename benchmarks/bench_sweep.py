@@ -24,7 +24,7 @@ Python process that imports the library and runs one small collision, numba's ca
 warm): the number of collisions of the mean size a job must hold for its fixed cost to
 be a tenth of its work. Load averages before and after; a figure taken with a load
 average above the number of cores is "UNDER LOAD — not a measurement of the target".
-Not a test: it reports.
+The figures go to benchmarks/results/ (``measure.write_result``). Not a test: it reports.
 """
 
 from __future__ import annotations
@@ -39,7 +39,18 @@ import time
 
 import numba
 import numpy as np
-from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, c_run, load_c, machine
+from measure import (
+    C_FLAGS,
+    MIN_REPEAT,
+    Conditions,
+    Figure,
+    OtherProcesses,
+    best_times,
+    c_run,
+    load_c,
+    machine,
+    write_result,
+)
 
 from chain.physics.builders import uniform_chain
 from chain.physics.materials import STEEL_100C6, contact_stiffness, sphere_mass
@@ -116,7 +127,7 @@ def main() -> None:
     collisions = sum(len(run["v_left"]) for run in runs)
     common = {"duration": args.duration}
     results = simulate_many(runs, **common)  # compile / load the kernels
-    with tempfile.TemporaryDirectory() as folder:
+    with tempfile.TemporaryDirectory() as folder, OtherProcesses(interval=1.0) as others:
         c_function, how = load_c(folder)
         print(f"C yardstick: {how}" if c_function else f"C yardstick skipped: {how}")
         contenders = {
@@ -126,8 +137,9 @@ def main() -> None:
         if c_function is not None:
             contenders["C, 1 core"] = lambda: c_sweep(c_function, results)
         best = best_times(contenders, args.repeat, clock=time.perf_counter)
-    fixed = job_fixed_cost(args.repeat)
+        fixed = job_fixed_cost(args.repeat)
     conditions.sample("after")
+    figures = []
     sizes = [run["model"].n_beads for run in runs]
     print(
         f"\n{collisions} collisions of N = {min(sizes)}..{max(sizes)} ({len(runs)} chains), "
@@ -139,10 +151,14 @@ def main() -> None:
     speed_up = one / all_cores
     per_core = collisions / all_cores / cores
     print(f"\n== summary (best of {args.repeat} interleaved, wall time)")
-    print(
-        f"speed-up {cores} threads / 1: {speed_up:.2f}  (target >= 1.8 on 2 cores: "
-        f"{conditions.verdict(speed_up >= 1.8) if cores == 2 else 'not 2 cores'})"
-    )
+    verdict = conditions.verdict(speed_up >= 1.8) if cores == 2 else "not 2 cores"
+    print(f"speed-up {cores} threads / 1: {speed_up:.2f}  (target >= 1.8 on 2 cores: {verdict})")
+    figures.append(
+        Figure(f"speed-up, {cores} threads / 1", speed_up, "x",
+               "the cores' share of the sweep's work (longest collision first)",
+               ratio_to="the same sweep on 1 thread, same run", target=">= 1.8 on 2 cores",
+               verdict=verdict)
+    )  # fmt: skip
     if c_function is not None:
         c_rate = collisions / best["C, 1 core"]
         ratio = per_core / c_rate
@@ -151,6 +167,15 @@ def main() -> None:
             f"0.75: {conditions.verdict(ratio >= 0.75)}); on 1 thread / C: "
             f"{collisions / one / c_rate:.2f}"
         )
+        c_yardstick = f"C RK4 ({' '.join(C_FLAGS)}) on 1 core, same run"
+        steps = "the kernel's steps, as C's (the same RK4 at the same step)"
+        figures += [
+            Figure(f"collisions/s per core, {cores} threads / C", ratio, "x", steps,
+                   ratio_to=c_yardstick, target=">= 0.75",
+                   verdict=conditions.verdict(ratio >= 0.75)),
+            Figure("collisions/s, 1 thread / C", collisions / one / c_rate, "x", steps,
+                   ratio_to=c_yardstick),
+        ]  # fmt: skip
     mean_work = one / collisions
     print(
         f"a job's fixed cost (fresh process, imports, cache load, one small collision): "
@@ -159,6 +184,11 @@ def main() -> None:
         "under a tenth of the work"
     )
     print(f"NUMBA_NUM_THREADS={os.environ.get('NUMBA_NUM_THREADS', 'unset')}")
+    figures.append(
+        Figure("a job's fixed cost", fixed, "s",
+               "a fresh interpreter's imports and numba's cache load, one small collision")
+    )  # fmt: skip
+    write_result("bench_sweep", figures, conditions, others.share)
 
 
 if __name__ == "__main__":

@@ -11,20 +11,30 @@ The machines the benchmarks run on are shared and noisy, so every speed figure i
   the 1-minute load average exceeded the number of cores is printed as
   :data:`UNDER_LOAD` and never as met.
 
+Every benchmark writes what it measured to ``benchmarks/results/<benchmark>.json``
+(:func:`write_result`: its figures with the machine, the load and the commit);
+``python benchmarks/table.py`` writes the table of ``benchmarks/README.md`` from those
+files.
+
 Not a test: nothing here asserts.
 """
 
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
+import json
 import math
 import os
 import platform
+import shlex
 import shutil
 import subprocess
+import sys
 import threading
 import time
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -39,17 +49,20 @@ UNDER_LOAD = "UNDER LOAD — not a measurement of the target"
 _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 
 
-def machine() -> str:
-    """CPU model and core count, read from /proc/cpuinfo where there is one."""
-    model = platform.processor() or platform.machine()
+def cpu_model() -> str:
+    """The CPU's model name, read from /proc/cpuinfo where there is one."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
+                return line.split(":", 1)[1].strip()
     except OSError:
         pass
-    return f"{model}, nproc {os.cpu_count()}"
+    return platform.processor() or platform.machine()
+
+
+def machine() -> str:
+    """CPU model and core count, read from /proc/cpuinfo where there is one."""
+    return f"{cpu_model()}, nproc {os.cpu_count()}"
 
 
 def load_average() -> float:
@@ -84,11 +97,13 @@ class Conditions:
 
     cores: int = field(default_factory=lambda: os.cpu_count() or 1)
     loads: list = field(default_factory=list)
+    labels: list = field(default_factory=list)
 
     def sample(self, label: str) -> float:
         """Read and print the load average now (``label``: "before", "after")."""
         load = load_average()
         self.loads.append(load)
+        self.labels.append(label)
         print(f"load average {label}: {load:.2f} on {self.cores} cores")
         return load
 
@@ -265,3 +280,160 @@ def c_run(function, velocity, mass, kappa, eta, dt, n_steps, record_every):
     pointers = [a.ctypes.data_as(_DOUBLE_P) for a in (u, v, force, energy)]
     function(n, mass, kappa, 1.5 * eta * kappa, dt, n_steps, record_every, *pointers)
     return force, energy
+
+
+# Results files: what a benchmark measured, where and when, and the table made of them.
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = Path(__file__).parent / "results"
+#: Keys of every results file, and of each of its figures.
+RESULT_KEYS = (
+    "benchmark",
+    "command",
+    "date_utc",
+    "commit",
+    "dirty",
+    "machine",
+    "load_average",
+    "others_cpu_share",
+    "loaded",
+    "figures",
+)
+FIGURE_KEYS = ("name", "value", "unit", "ratio_to", "target", "verdict", "bounded_by")
+#: Units of figures that the load does not change (peak memory, a count of jobs): judged
+#: as measured.
+LOAD_INDEPENDENT_UNITS = ("MB", "jobs")
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One figure a benchmark measured: ``value`` in ``unit``.
+
+    ``ratio_to`` names the yardstick, measured in the same run, that ``value`` is a ratio
+    to (None: an absolute figure); ``target`` the bound it is judged against ("": none)
+    and ``verdict`` the judgement ("met", "not met", :data:`UNDER_LOAD`, or ""); and
+    ``bounded_by`` says in one line what sets the figure (what the work costs at best).
+    """
+
+    name: str
+    value: float | None
+    unit: str
+    bounded_by: str
+    ratio_to: str | None = None
+    target: str = ""
+    verdict: str = ""
+
+
+def _git(*args: str) -> str | None:
+    try:
+        done = subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True)
+    except OSError:
+        return None
+    return done.stdout.strip() if done.returncode == 0 else None
+
+
+def commit() -> tuple[str | None, bool | None]:
+    """The checkout's commit (short hash) and whether its files differ from it (the
+    results files and the benchmarks' README excepted: they change nothing measured)."""
+    status = _git(
+        "status",
+        "--porcelain",
+        "--",
+        ".",
+        ":(exclude)benchmarks/results",
+        ":(exclude)benchmarks/README.md",
+    )
+    return _git("rev-parse", "--short", "HEAD"), None if status is None else bool(status)
+
+
+def machine_info() -> dict:
+    """The machine and the versions a figure depends on."""
+
+    def version(package: str) -> str | None:
+        try:
+            return importlib.metadata.version(package)
+        except importlib.metadata.PackageNotFoundError:
+            return None
+
+    return {
+        "cpu": cpu_model(),
+        "cores": os.cpu_count(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "numba": version("numba"),
+    }
+
+
+def command_line() -> str:
+    """The command that runs this benchmark, as typed from the repository's root."""
+    script = Path(sys.argv[0]).resolve()
+    if script.is_relative_to(ROOT):
+        script = script.relative_to(ROOT)
+    return shlex.join(["python", str(script), *sys.argv[1:]])
+
+
+def _finite(value):
+    return None if value is None or not math.isfinite(value) else value
+
+
+def _loads(conditions: Conditions) -> dict:
+    """The first and last load average read, and every reading when there were more."""
+    loads = [_finite(round(load, 2)) for load in conditions.loads] or [None]
+    readings = {"cores": conditions.cores, "before": loads[0], "after": loads[-1]}
+    if conditions.labels not in ([], ["before", "after"]):
+        readings["readings"] = dict(zip(conditions.labels, loads, strict=True))
+    return readings
+
+
+def write_result(
+    benchmark: str,
+    figures: list[Figure],
+    conditions: Conditions,
+    others: float | None = None,
+    *,
+    own_load: bool = False,
+    folder: Path = RESULTS,
+) -> Path:
+    """Write ``folder/<benchmark>.json``: the ``figures``, the command line, the date
+    (UTC), the commit (and whether the checkout differed from it), the machine, the load
+    averages that ``conditions`` read and ``others``, the share of the machine's CPU that
+    other processes took meanwhile (:class:`OtherProcesses`; None: not measured).
+
+    The run is ``loaded`` when others took more than :data:`MAX_OTHER_SHARE` or (unless
+    ``own_load``: the benchmark loads every core itself, as a workflow does) a load
+    average exceeded the cores; then no figure is "met" (its verdict becomes
+    :data:`UNDER_LOAD`), except a peak memory (:data:`LOAD_INDEPENDENT_UNITS`)."""
+    loaded = not (others is None or others <= MAX_OTHER_SHARE)
+    loaded = loaded or (conditions.under_load and not own_load)
+    rows = []
+    for figure in figures:
+        row = {key: getattr(figure, key) for key in FIGURE_KEYS}
+        row["value"] = _finite(figure.value)
+        if isinstance(row["value"], float):
+            row["value"] = float(f"{row['value']:.4g}")
+        if loaded and figure.verdict == "met" and figure.unit not in LOAD_INDEPENDENT_UNITS:
+            row["verdict"] = UNDER_LOAD
+        rows.append(row)
+    head, dirty = commit()
+    result = {
+        "benchmark": benchmark,
+        "command": command_line(),
+        "date_utc": datetime.now(UTC).strftime("%Y-%m-%dT%H:%MZ"),
+        "commit": head,
+        "dirty": dirty,
+        "machine": machine_info(),
+        "load_average": _loads(conditions),
+        "others_cpu_share": None if others is None else _finite(round(others, 4)),
+        "loaded": loaded,
+        "figures": rows,
+    }
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{benchmark}.json"
+    path.write_text(json.dumps(result, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    print(f"results: {path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}")
+    return path
+
+
+def read_results(folder: Path = RESULTS) -> list[dict]:
+    """Every results file of ``folder``, by benchmark name."""
+    return [json.loads(p.read_text(encoding="utf-8")) for p in sorted(folder.glob("*.json"))]

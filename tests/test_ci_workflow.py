@@ -1,6 +1,7 @@
 """The GitHub Actions workflow (.github/workflows/ci.yml): valid against the workflow
 schema bundled with check-jsonschema (offline), so a broken file fails here before it
-fails on GitHub; its commands are the README's, so what CI runs is what a user types."""
+fails on GitHub; its commands are those of the page on CI (docs/ci.md), verbatim, and
+the quick start's are the README's, so what CI runs is what a user types."""
 
 from __future__ import annotations
 
@@ -12,8 +13,10 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 WORKFLOWS = sorted((ROOT / ".github" / "workflows").glob("*.yml"))
-#: Commands of the project a step may run; they must appear in the README verbatim.
+#: Commands of the project a step may run; they must appear in docs/ci.md verbatim.
 PROJECT_COMMANDS = ("pip ", "python ", "snakemake ", "hertzchain ")
+#: The quick start's commands: CI runs them, and the README gives them.
+QUICK_START = ('pip install -e ".[test]"', "snakemake --cores 2", "python -m pytest")
 
 
 def validate(path: Path) -> subprocess.CompletedProcess:
@@ -43,20 +46,23 @@ def _steps(workflow: dict):
         yield from job["steps"]
 
 
-def test_steps_are_the_readme_commands_and_keep_the_run():
+def test_steps_are_the_documented_commands_and_keep_the_run():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    page = (ROOT / "docs" / "ci.md").read_text(encoding="utf-8")
+    assert "docs/ci.md" in readme  # the README leads to the page
     workflow = yaml.safe_load(WORKFLOWS[0].read_text(encoding="utf-8"))
     commands = [s["run"].strip() for s in _steps(workflow) if "run" in s]
     project = [c for c in commands if c.startswith(PROJECT_COMMANDS)]
-    assert "snakemake --cores 2" in project and "python -m pytest" in project
-    assert 'pip install -e ".[test]"' in project
-    missing = [c for c in project if c not in readme]
-    assert not missing, f"commands of the workflow that the README does not give: {missing}"
+    assert set(QUICK_START) <= set(project)
+    for command in QUICK_START:
+        assert command in readme, f"the README's quick start lacks {command}"
+    missing = [c for c in project if c not in page]
+    assert not missing, f"commands of the workflow that docs/ci.md does not give: {missing}"
     uploads = [s for s in _steps(workflow) if s.get("uses", "").startswith("actions/upload")]
     assert {u["with"]["name"] for u in uploads} == {"paper-run", "paper-run-extras"}
     for upload in uploads:
         assert "results/paper/article.pdf" in upload["with"]["path"]
-        assert upload["with"]["name"] in readme  # the README says how to get it
+        assert upload["with"]["name"] in page  # the page says how to get it
 
 
 def _installs(job: dict) -> list[str]:
