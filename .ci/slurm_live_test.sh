@@ -4,7 +4,7 @@
 # user meets, and compare the results byte for byte with a local run of the same config.
 #
 #   1. Snakemake killed (SIGKILL: a dropped ssh session, an OOM kill) while its jobs run.
-#      The test then does what the README tells a user: retypes the command (Snakemake
+#      The test then does what docs/cluster.md tells a user: retypes the command (Snakemake
 #      refuses: the directory is locked, "--unlock"), waits until the killed run's jobs
 #      have left the queue, `--unlock`s, and reruns the same command.
 #   2. One job of that rerun cancelled by `scancel` while it runs (preemption, a lost
@@ -267,7 +267,7 @@ start=$SECONDS
 say "local run: $((SECONDS - start)) s (load average $(load))"
 copy_checkout "$WORK/slurm" "$WORK/local"
 
-# The command a user types (README), plus the settings of this test cluster only (a real
+# The command a user types (README, docs/cluster.md), plus the settings of this test cluster only (a real
 # cluster has sacct and an account): squeue for job states, no account, first status
 # check after 2 s, 5 s for outputs to appear (one file system), as many jobs at once as
 # the partition runs (4 per core).
@@ -337,7 +337,7 @@ run_snakemake 300 "$WORK/slurm-run-locked.log"
     grep -q -- '--unlock' "$WORK/slurm-run-locked.log" ||
     fail "retyped after the kill, Snakemake did not stop on its lock naming --unlock (status $STATUS)"
 say "retyped: Snakemake refuses, \"Directory cannot be locked ... --unlock\""
-# The README: wait until the killed run's jobs (job name: its SLURM run ID) have left
+# docs/cluster.md: wait until the killed run's jobs (job name: its SLURM run ID) have left
 # the queue, then unlock.
 wait_until 1200 "the jobs of the killed run to end in SLURM (squeue -n $RUN1)" \
     run_over "$RUN1"

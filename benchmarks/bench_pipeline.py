@@ -1,16 +1,21 @@
 """What a user waits for: the paper run, a forced rebuild, three what-ifs and the tests
-(issue 33), each with its job count, against its target.
+(issues 33, 52), each with its job count, against its target; and what the job server
+saves (issue 53).
 
 Every round works in a fresh copy of the checkout (the files git tracks, no numba cache,
-no results, no reuse store: a fresh clone), whose ``src`` the jobs import, and runs in
+no results, no result store: a fresh clone), whose ``src`` the jobs import, and runs in
 order::
 
     paper       snakemake --cores 2                       numba's cache empty
-    forced      snakemake --cores 2 --forceall --config reuse=False    warm numba cache,
-                                                          every job computed again
+    forced      snakemake --cores 2 --forceall            warm numba cache, every job
+                                                          computed again
     brass       snakemake --cores 2 --configfile whatif/brass.yaml     after the paper run
     analysis    an overlay: run_name bench_analysis, analysis: {main_estimator: peak}
     figure      an overlay: run_name bench_figure, figures: {representative_force_N: 100}
+
+then, in a second fresh copy, ``paper``, ``forced`` and ``figure`` again with every job
+in its own process (``HERTZCHAIN_JOB_SERVER=off``): the server's saving on the cold and
+the warm paper run and on the figure what-if, measured in the same round.
 
 The targets are issue 33's, in seconds on the machine it was measured on. Each round
 also runs a **yardstick**: the paper run of the commit the issue measured
@@ -37,8 +42,8 @@ README's test command runs once in the last copy (``--no-tests`` skips it)::
     python benchmarks/bench_pipeline.py                  # 3 rounds and the tests
     python benchmarks/bench_pipeline.py --repeat 1 --no-tests --keep /tmp/bench
 
-Each scenario's jobs are counted as run (the job started) or reused (its result taken
-from results/.cache, issue 33: its log stays empty). For the paper run it also prints,
+Each scenario's jobs are counted as run (computed) or reused (its result taken from the
+store: its log says so). For the paper run it also prints,
 per rule, the jobs and their summed wall time from Snakemake's own start and finish
 lines (whole seconds): what bounds the figure. The best times, their ratios to the
 yardstick and their verdicts go to benchmarks/results/ (``measure.write_result``).
@@ -75,13 +80,17 @@ ROOT = Path(__file__).resolve().parents[1]
 #: (name, snakemake arguments, overlay written into the copy or None, target s, stretch s)
 SCENARIOS = (
     ("paper", [], None, 45.0, 30.0),
-    ("forced", ["--forceall", "--config", "reuse=False"], None, None, None),
+    ("forced", ["--forceall"], None, None, None),
     ("brass", ["--configfile", "whatif/brass.yaml"], None, 40.0, None),
     ("analysis", ["--configfile", "bench_analysis.yaml"],
      "run_name: bench_analysis\nanalysis: {main_estimator: peak}\n", 15.0, None),
     ("figure", ["--configfile", "bench_figure.yaml"],
      "run_name: bench_figure\nfigures: {representative_force_N: 100}\n", 10.0, None),
 )  # fmt: skip
+#: Scenarios run again with every job in its own process (a copy of their own).
+WITHOUT_SERVER = ("paper", "forced", "figure")
+#: Below this saving of the warm paper run, issue 53 removes the job server.
+SERVER_WORTH = 0.15
 #: The commit issue 33 measured (113 s for the paper run, fresh clone, ``.[test]``, 2
 #: cores) and that time, s: the yardstick that scales the targets to this machine.
 BASELINE_COMMIT = "9fb9b1b"
@@ -112,8 +121,7 @@ _FINISH = re.compile(r"^Finished jobid: (\d+) \(Rule: (\w+)\)$")
 
 def jobs_of(printed: str, work: Path) -> pd.DataFrame:
     """One row per job Snakemake printed: rule, wall s (its start and finish lines, whole
-    seconds) and whether it ran (its log is not empty; a job reused from results/.cache
-    never starts and leaves an empty log)."""
+    seconds) and whether it ran (computed: its log does not say it was reused)."""
     jobs, stamp, current = {}, None, None
     for line in printed.splitlines():
         if match := _STAMP.match(line):
@@ -132,7 +140,7 @@ def jobs_of(printed: str, work: Path) -> pd.DataFrame:
     rows = []
     for job in jobs.values():
         log = work / job["log"] if job["log"] else None
-        ran = log is None or (log.is_file() and log.stat().st_size > 0)
+        ran = log is None or not log.read_text().startswith("reused from the store")
         rows.append({"rule": job["rule"], "wall_s": job.get("wall_s", 0.0), "ran": ran})
     return pd.DataFrame(rows, columns=["rule", "wall_s", "ran"])
 
@@ -161,10 +169,12 @@ def copy_commit(commit: str, work: Path) -> None:
     subprocess.run(["tar", "-x", "-C", str(work)], input=archive, check=True)
 
 
-def environment(work: Path) -> dict:
-    """The environment of a run in the copy: its jobs import the copy's library."""
+def environment(work: Path, server: bool = True) -> dict:
+    """The environment of a run in the copy: its jobs import the copy's library (and
+    each runs in its own process unless ``server``)."""
     path = os.pathsep.join([str(work / "src"), os.environ.get("PYTHONPATH", "")])
-    return {**os.environ, "PYTHONPATH": path}
+    off = {} if server else {"HERTZCHAIN_JOB_SERVER": "off"}
+    return {**os.environ, "PYTHONPATH": path, **off}
 
 
 @dataclass(frozen=True)
@@ -180,13 +190,13 @@ class Timed:
         return self.others <= MAX_OTHER_SHARE
 
 
-def run(command: list[str], work: Path) -> tuple[Timed, str]:
+def run(command: list[str], work: Path, server: bool = True) -> tuple[Timed, str]:
     """Run ``command`` in the copy; its time and what it printed."""
     start = time.perf_counter()
     with OtherProcesses() as others:
         done = subprocess.run(
-            command, cwd=work, capture_output=True, text=True, env=environment(work),
-            stdin=subprocess.DEVNULL,
+            command, cwd=work, capture_output=True, text=True,
+            env=environment(work, server), stdin=subprocess.DEVNULL,
         )  # fmt: skip
     elapsed = Timed(time.perf_counter() - start, others.share)
     if done.returncode != 0:
@@ -206,19 +216,25 @@ def yardstick(work: Path, cores: int) -> Timed:
 
 
 def one_round(work: Path, cores: int) -> dict:
-    """Every scenario once, in order, in a fresh copy: name -> (wall s, its jobs)."""
-    copy_checkout(work)
+    """Every scenario once, in order, in a fresh copy, then :data:`WITHOUT_SERVER` in
+    another: name -> (wall s, its jobs)."""
     timings = {}
-    for name, args, overlay, _, _ in SCENARIOS:
-        if overlay:
-            (work / f"bench_{name}.yaml").write_text(overlay)
-        command = [sys.executable, "-m", "snakemake", "--cores", str(cores), *args]
-        timed, printed = run(command, work)
-        jobs = jobs_of(printed, work)
-        timings[name] = (timed, jobs)
-        print(f"  {name}: {timed.wall:.1f} s, {int(jobs['ran'].sum())} jobs run, "
-              f"{int((~jobs['ran']).sum())} reused, other processes {timed.others:.1%} "
-              f"of the CPU", flush=True)  # fmt: skip
+    for server in (True, False):
+        folder = work / ("server" if server else "own_processes")
+        copy_checkout(folder)
+        for name, args, overlay, _, _ in SCENARIOS:
+            if not server and name not in WITHOUT_SERVER:
+                continue
+            if overlay:
+                (folder / f"bench_{name}.yaml").write_text(overlay)
+            command = [sys.executable, "-m", "snakemake", "--cores", str(cores), *args]
+            timed, printed = run(command, folder, server)
+            jobs = jobs_of(printed, folder)
+            key = name if server else f"{name}, no server"
+            timings[key] = (timed, jobs)
+            print(f"  {key}: {timed.wall:.1f} s, {int(jobs['ran'].sum())} jobs run, "
+                  f"{int((~jobs['ran']).sum())} reused, other processes {timed.others:.1%} "
+                  f"of the CPU", flush=True)  # fmt: skip
     return timings
 
 
@@ -303,6 +319,7 @@ def summarise(rounds: list[dict], scale: Timed | None) -> list[Figure]:
                 Figure(f"{name} / yardstick", timed.wall / scale.wall, "x", BOUNDS[name], ratio_to,
                        _target(*limits), _judged(here))
             )  # fmt: skip
+    figures += server_savings(rounds)
     analysis = rounds[-1]["analysis"][1]
     simulated = analysis[analysis["ran"] & analysis["rule"].isin(SIMULATIONS)]
     print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none): "
@@ -312,6 +329,27 @@ def summarise(rounds: list[dict], scale: Timed | None) -> list[Figure]:
                "the jobs whose inputs the estimator does not change are reused", None,
                "0", "met" if simulated.empty else "not met")
     )  # fmt: skip
+    return figures
+
+
+def server_savings(rounds: list[dict]) -> list[Figure]:
+    """What the job server saves on each scenario of :data:`WITHOUT_SERVER`: 1 - (best
+    with) / (best without), interleaved in the same rounds. Issue 53 keeps the server
+    only if it saves :data:`SERVER_WORTH` of the warm paper run (``forced``)."""
+    figures = []
+    print("\nthe job server (every job in its own process without it):")
+    for name in WITHOUT_SERVER:
+        best = [min(r[key][0].wall for r in rounds) for key in (name, f"{name}, no server")]
+        saving = 1.0 - best[0] / best[1]
+        worth = f" (keep the server if >= {SERVER_WORTH:.0%})" if name == "forced" else ""
+        print(f"  {name:9s} {best[0]:6.1f} s with, {best[1]:6.1f} s without: "
+              f"saves {saving:.1%}{worth}")  # fmt: skip
+        figures.append(
+            Figure(f"{name}: job server's saving", 100 * saving, "%",
+                   "the imports each job's own process pays", f"{name} without the server",
+                   f">= {SERVER_WORTH:.0%}" if worth else "",
+                   ("met" if saving >= SERVER_WORTH else "not met") if worth else "")
+        )  # fmt: skip
     return figures
 
 
@@ -347,7 +385,7 @@ def main(argv=None) -> int:
         if not args.no_tests:
             conditions.sample("before the tests")
             tests = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
-            timed, printed = run(tests, work)
+            timed, printed = run(tests, work / "server")
             conditions.sample("after the tests")
             closing = printed.strip().splitlines()[-1]
             judged = verdict(timed, TESTS_TARGET_S, None)
