@@ -95,8 +95,9 @@ ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "tests" / "configs" / "repro.yaml"
 RUN = "repro"
 SNAKEMAKE = [sys.executable, "-m", "snakemake", "--configfile", "repro.yaml"]
-#: Top-level entries of results/<run>/ that legitimately hold times: not compared.
-TIMED = ("logs", "benchmarks", "report.html")
+#: Top-level entries of results/<run>/ that legitimately hold times: not compared
+#: (SHA256SUMS lists the logs' digests; it must check, test_interrupted_rebuild...).
+TIMED = ("logs", "benchmarks", "report.html", "SHA256SUMS")
 #: Longest a Snakemake call may take, s: a guard against a hang, far above a build's
 #: minutes on a machine shared with other workers (pytest-xdist) or other work.
 TIMEOUT = 1800
@@ -462,11 +463,23 @@ def test_interrupted_rebuild_resumes_to_the_same_bytes(rebuilt, first, second):
         f"interrupted ({first}) and resumed",
         may_be_missing=INTERMEDIATES,
     )
+    assert_checksums_hold(ws.out)
     interrupted_run(ws, expected, ["--forceall", "--cores", "2"], "tables", second)
     resume(ws, expected, second)
     assert_same_bytes(
         ws, expected, f"interrupted ({second}) and resumed", may_be_missing=INTERMEDIATES
     )
+    assert_checksums_hold(ws.out)
+
+
+def assert_checksums_hold(out: Path) -> None:
+    """The run folder's SHA256SUMS, where a run left one (each run that ran a job;
+    after a SIGKILL none until then), lists its files as they are."""
+    if (out / "SHA256SUMS").exists():
+        check = subprocess.run(
+            ["sha256sum", "-c", "--quiet", "SHA256SUMS"], cwd=out, capture_output=True, text=True
+        )
+        assert check.returncode == 0, check.stdout + check.stderr
 
 
 # ---- part 3: atomic writes (unit) ---------------------------------------------------

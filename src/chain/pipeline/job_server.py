@@ -1,35 +1,18 @@
-"""The job server: a workflow's jobs run where their imports are already paid.
+"""The job server: a local run's jobs run where their imports are already paid
+(``docs/job_server.md``).
 
-A job of this workflow is a fresh Python process that spends most of its time starting
-up: ``import pandas`` 0.5-0.7 s, ``scipy.optimize`` 0.9 s, ``numba`` 0.8 s,
-``matplotlib.pyplot`` 1.1 s, against a few tenths of a second of work for most steps.
-So a local run starts one server (:func:`start`, while Snakemake parses the workflow,
-so that it imports on the other core while Snakemake builds the DAG; :func:`publish`
-from the Snakefile's ``onstart``, once the run is known to be local) that imports,
-once, every module the workflow's scripts import, and serves jobs on a Unix socket
-(from the start: a job that comes while it imports is served between two imports, and
-imports the rest itself); before each job that integrates it loads the kernel versions
-numba's cache holds that it does not.
-Each job is still its own Snakemake job, with its own script, inputs, outputs, log and
-exit status; its process (the *client*) hands the job over (:func:`hand_off`, the first
-import of every script) and the server forks a child that runs the same script, with
-the client's working directory, environment, standard streams and ``sys.path``. The
-child shares the server's imported modules and nothing else: each job is a separate
-process, as before, and gives the same bytes (tests/test_job_server.py and the
-workflow tests compare the two ways).
+A local run starts one server (:func:`start`, while Snakemake builds the DAG;
+:func:`publish` in ``onstart``) that imports what the workflow's scripts import and
+serves jobs on a Unix socket: each job's own process (the *client*, :func:`hand_off`)
+hands its script over, and the server forks a child that runs it with the client's
+directory, environment, streams and ``sys.path``. The client passes SIGINT and SIGTERM
+on and exits with the child's status; a child whose client dies is stopped, and the
+server exits with its Snakemake (``PR_SET_PDEATHSIG``).
 
-Only its owner can hand it a job: it listens on a socket in a folder of its own that
-only the owner may enter (0700), checks each peer's uid (``SO_PEERCRED``) before it
-reads a byte, and takes requests as JSON, never pickle. A job whose interpreter,
-``sys.prefix`` or root file system (a container) is not the server's runs in its own
-process, in its own environment, as it would without a server.
-
-The client stays for the whole job, so Snakemake sees a job end when its work ends:
-it passes SIGINT and SIGTERM on to the child and exits with the child's status. A
-child whose client dies (SIGKILL) is stopped with SIGTERM, so its atomic writers clean
-up; a server whose Snakemake dies exits (``PR_SET_PDEATHSIG`` and a check of its
-parent). With no server (a cluster job, ``HERTZCHAIN_JOB_SERVER=off``, a server that
-is not up), a job runs in its own process as it always did.
+Only its owner can hand it a job: the socket sits in a folder only the owner may enter
+(0700), each peer's uid is checked (``SO_PEERCRED``) before a byte is read, and requests
+are JSON, never pickle. A job whose interpreter, ``sys.prefix`` or root file system (a
+container) is not the server's runs in its own process, as with no server at all.
 """
 
 from __future__ import annotations

