@@ -309,3 +309,29 @@ def test_the_forecast_follows_stored_results_down_the_chain(tmp_path, monkeypatc
     chained = Job.of("pulses", Named([]), Named([]), Named(list(other.outputs)), Named(["x"]))
     assert forecast([chained, other], store, folder) == 0
     assert json.loads((next(store.root.glob("??/*")) / "manifest.json").read_text())["key"]
+
+
+def _store_many(root: str, outputs: list[str], run: str) -> None:
+    store = Store.open({STORE_VARIABLE: root})
+    for k in range(20):
+        store.put(f"{k:02d}" * 32, outputs, {"run": run})
+
+
+def test_two_runs_storing_at_once_leave_only_whole_entries(tmp_path, outputs):
+    """Two processes storing the same twenty results at the same time: every entry is
+    whole (its files match its manifest) and the staging area is empty."""
+    import multiprocessing
+
+    root = str(tmp_path / "store")
+    context = multiprocessing.get_context("fork")
+    writers = [context.Process(target=_store_many, args=(root, outputs, run)) for run in ("a", "b")]
+    for writer in writers:
+        writer.start()
+    for writer in writers:
+        writer.join(timeout=300)
+        assert writer.exitcode == 0
+    store = Store.open({STORE_VARIABLE: root})
+    for k in range(20):
+        again = [str(tmp_path / f"check{k}" / Path(p).name) for p in outputs]
+        assert store.fetch(f"{k:02d}" * 32, again)["run"] in ("a", "b")
+    assert list((store.root / "tmp").iterdir()) == []
