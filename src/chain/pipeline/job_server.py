@@ -28,9 +28,10 @@ import subprocess
 import sys
 import tempfile
 import time
-import traceback
 from dataclasses import dataclass
 from pathlib import Path
+
+from chain.pipeline.job_script import SIGNAL_BASE, run_script, signals_once
 
 #: Environment variable: the server's socket (set by :func:`publish` for the jobs), or
 #: ``off`` to run every job in its own process.
@@ -42,9 +43,6 @@ _IN_SERVER = False
 #: The server's log (a copy of its stdout, which a child replaces with its job's).
 _SERVER_LOG = 1
 
-#: Exit status of a child killed by a signal: the shell's convention, 128 + signal.
-_SIGNAL_BASE = 128
-
 _HEADER = struct.Struct("!Q")  # length of the JSON request
 _REQUEST_TIMEOUT = 10.0  # s: a client sends its request as soon as it has connected
 _STATUS = struct.Struct("!q")  # the child's pid, then its exit status
@@ -54,15 +52,8 @@ _STATUS = struct.Struct("!q")  # the child's pid, then its exit status
 
 
 def run(script: str) -> int:
-    """Run a job's ``script`` in the workflow's job server if one is up and takes it,
-    else in this process; its exit status.
-
-    Parameters
-    ----------
-    script : str
-        The file the job's interpreter is running: Snakemake's copy of the workflow
-        script with its preamble (``__real_file__``).
-    """
+    """Run a job's ``script`` (Snakemake's copy, with its preamble) in the job server
+    if one is up and takes it, else in this process; its exit status."""
     status = hand_off(script)
     return run_script(script) if status is None else status
 
@@ -86,7 +77,7 @@ def hand_off(script: str) -> int | None:
     Parameters
     ----------
     script : str
-        As :func:`run`'s.
+        The job's script: Snakemake's copy, with its preamble (``__real_file__``).
     """
     address = os.environ.get(ADDRESS_VARIABLE, "off")
     if _IN_SERVER or address == "off":
@@ -127,7 +118,7 @@ def _wait_for(connection: socket.socket, child: int) -> int:
         signal.signal(signum, pass_on)
     status = _receive(connection)
     # No status: the child died without reporting (SIGKILL); a job that fails.
-    return _SIGNAL_BASE + signal.SIGKILL if status is None else status
+    return SIGNAL_BASE + signal.SIGKILL if status is None else status
 
 
 def _receive(connection: socket.socket) -> int | None:
@@ -152,18 +143,12 @@ class Server:
     """A job server that :func:`start` started: its process and its address."""
 
     process: subprocess.Popen
-    address: str
-
-    @property
-    def folder(self) -> Path:
-        """The server's private folder (0700), which holds its socket."""
-        return Path(self.address).parent
+    address: str  # its socket, in a folder of its own (0700)
 
 
 def start(scripts: str | os.PathLike, log: str | os.PathLike) -> Server | None:
-    """Start a job server for the jobs of this process (a local Snakemake run). Returns
-    at once: the server imports while Snakemake goes on, and serves jobs once
-    :func:`publish` has told them where it is.
+    """Start a job server for the jobs of this process (a local Snakemake run); it
+    serves them once :func:`publish` has told them where it is.
 
     Parameters
     ----------
@@ -210,8 +195,8 @@ def publish(server: Server | None) -> None:
 
 
 def stop(server: Server | None) -> None:
-    """Stop a server :func:`start` started (None: nothing to do) and take its address
-    back from the jobs; its running children, if any, finish their jobs.
+    """Stop a server :func:`start` started (None: nothing to do), take its address back
+    from the jobs and remove its folder; its running children finish their jobs.
 
     Parameters
     ----------
@@ -226,23 +211,16 @@ def stop(server: Server | None) -> None:
         server.process.terminate()
         with contextlib.suppress(subprocess.TimeoutExpired):
             server.process.wait(timeout=10)
-    shutil.rmtree(server.folder, ignore_errors=True)
+    shutil.rmtree(Path(server.address).parent, ignore_errors=True)
 
 
 def serve(address: str, scripts: Path) -> None:
     """The server's main loop: listen at ``address``, fork a child per job until the
     parent (Snakemake) is gone or a SIGTERM or SIGINT arrives (then it exits at once),
-    and meanwhile import what the ``scripts`` import; before each job, load what it
-    needs that the library defers (imports in functions, numba's cached kernels).
-
-    The imports run one module at a time, between jobs: a job that arrives first is
-    forked at once, with what is imported so far, and imports the rest itself, as it
-    would in its own process; what the library it runs imports inside its functions
-    is imported first, once for all later jobs
-    (:func:`chain.pipeline.preload.load_deferred_imports_for`), and for one that
-    integrates the kernels are loaded (:func:`chain.pipeline.preload.load_kernels_for`).
-    A run of a few jobs (a figure what-if) does not wait for the whole preload (~3 s)
-    before its first job; a long run soon has it all.
+    and between jobs import what the ``scripts`` import, one module at a time (a job
+    that comes first is forked with what is imported so far). Before each job, load
+    what the library it runs defers (imports in functions, numba's cached kernels:
+    :mod:`chain.pipeline.preload`).
 
     Parameters
     ----------
@@ -307,13 +285,12 @@ def _die_with_parent() -> None:
 
 
 def _run_child(connection: socket.socket, request: dict, fds: list[int]) -> None:
-    """Become the process of the job that sent ``request`` and the streams ``fds``
-    (:func:`_read_request`) and run its script; report the exit status and exit. Never
-    returns. A child that fails before it has sent its pid closes without a word, and
-    the client runs the job itself."""
+    """Become the job that sent ``request`` and ``fds`` (:func:`_read_request`), run
+    its script, report its exit status and exit. A child that fails before it sent its
+    pid closes without a word: the client then runs the job itself."""
     global _IN_SERVER
     _IN_SERVER = True
-    _signals_once()
+    signals_once()
     started, status = False, 1
     try:
         _adopt(request, fds)
@@ -401,34 +378,6 @@ def _adopt(request: dict, fds: list[int]) -> None:
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the job's own children are waited for
 
 
-def stop_once(signum: int, frame) -> None:
-    """Signal handler: end the job as SIGINT (KeyboardInterrupt) or SIGTERM (SystemExit
-    with status 128 + signal) do, once; later SIGINT and SIGTERM are ignored, so that a
-    signal that arrives twice (sent to the process group, it reaches a job in the server
-    both directly and through its client) cannot cut the atomic writers' clean-up short.
-    The scripts' SIGTERM handler too (workflow/scripts/_logging.py).
-
-    Parameters
-    ----------
-    signum : int
-        The signal's number.
-    frame : frame or None
-        The interrupted frame (unused).
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    if signum == signal.SIGINT:
-        raise KeyboardInterrupt
-    raise SystemExit(_SIGNAL_BASE + signum)
-
-
-def _signals_once() -> None:
-    """SIGINT and SIGTERM act in a child as in a job's own process, once
-    (:func:`stop_once`)."""
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, stop_once)
-
-
 def _stop_when_client_dies(connection: socket.socket) -> None:
     """SIGTERM this child if its client goes away (killed): the job is over for
     Snakemake, and the atomic writers clean up on SystemExit."""
@@ -440,34 +389,6 @@ def _stop_when_client_dies(connection: socket.socket) -> None:
         os.kill(os.getpid(), signal.SIGTERM)
 
     threading.Thread(target=watch, daemon=True).start()
-
-
-def run_script(script: str) -> int:
-    """Run ``script`` as this process's ``__main__``; its exit status, as Python's
-    would be.
-
-    Parameters
-    ----------
-    script : str
-        A Python file.
-    """
-    import runpy
-
-    try:
-        runpy.run_path(script, run_name="__main__")
-    except SystemExit as stop:
-        code = stop.code
-        if code is None or isinstance(code, int):
-            return code or 0
-        print(code, file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        traceback.print_exc()
-        return _SIGNAL_BASE + signal.SIGINT
-    except BaseException:
-        traceback.print_exc()
-        return 1
-    return 0
 
 
 if __name__ == "__main__":
