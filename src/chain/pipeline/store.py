@@ -23,6 +23,8 @@ import shutil
 import stat
 from pathlib import Path
 
+from chain.atomic import ordinary_mode, write_text_atomic
+
 #: Environment variable naming the store's folder (default :data:`DEFAULT_FOLDER`).
 STORE_VARIABLE = "HERTZCHAIN_STORE"
 #: Environment variable naming the one group the store is shared with, if any.
@@ -78,19 +80,6 @@ def _files_under(folder: Path) -> list[str]:
     )
 
 
-def _umask() -> int:
-    # /proc says it without changing it (os.umask would, for every thread of the job).
-    try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("Umask:"):
-                return int(line.split()[1], 8)
-    except OSError:
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 class Store:
     """A store folder, made or checked by :meth:`open`.
 
@@ -105,7 +94,7 @@ class Store:
     def __init__(self, root: Path, group: int | None = None):
         self.root, self.group = Path(root), group
         # Read-only; for a group, readable by it whatever the umask, never by others.
-        self.file_mode = 0o444 & ~_umask() if group is None else 0o440
+        self.file_mode = 0o444 & ordinary_mode() if group is None else 0o440
         self.folder_mode = 0o700 if group is None else 0o2770
 
     @classmethod
@@ -304,8 +293,6 @@ def write_checksums(folder: str | os.PathLike) -> Path:
     folder : path
         A run folder (``results/<run_name>``).
     """
-    from chain.atomic import write_text_atomic
-
     folder = Path(folder)
     lines = [
         f"{file_digest(folder / name)}  {name}\n"
