@@ -26,7 +26,7 @@ SECOND = """\
 import toy_kernel as toy
 from chain.physics import compile_once
 print("calling", flush=True)
-result = compile_once.call(toy.twice, 1.5)
+result = compile_once.shared(toy.twice)(1.5)
 stats = toy.twice.stats
 print(result, sum(stats.cache_hits.values()), sum(stats.cache_misses.values()), flush=True)
 """
@@ -69,5 +69,5 @@ def test_a_kernel_without_cache_is_called_without_a_lock():
     def add(a, b):
         return a + b
 
-    assert compile_once.call(add, 2, 3) == 5
+    assert compile_once.shared(add)(2, 3) == 5
     assert len(add.overloads) == 1

@@ -238,10 +238,9 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     literal argument would compile it again)."""
     links = (links, np.arange(links.shape[0]))
     particles = (particles, np.arange(particles.shape[0]))
-    status, step, refined, _, _, _ = compile_once.call(
-        _integrate_part,
-        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1,
-    )  # fmt: skip
+    status, step, refined, _, _, _ = _integrate_part(
+        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1
+    )
     return status, step, refined
 
 
@@ -305,6 +304,7 @@ def _work_buffers(n):
     )  # fmt: skip
 
 
+@compile_once.shared
 @numba.njit(cache=True, nogil=True)
 def _integrate_part(
     u, v, params, dt, step, n_steps, record_every, links, particles, outputs,
