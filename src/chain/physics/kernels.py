@@ -148,7 +148,7 @@ def _record(u, v, dissipated, model, links, particles, sample, outputs):
     return finite
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _potential_energy(u, k, kind, walls):
     n = u.shape[0]
     energy = 0.0
@@ -172,11 +172,9 @@ def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag):
     increment = 0.0
     event = False
     for _ in range(EVENT_SUBSTEPS):
-        buffers = (work[0], work[1], work[2], work[3], work[4], u_b, v_b)
-        part, varied = _rk4(
-            u, v, acc, slope, h, buffers, work[6], im, k, c, keys, springs, walls, drag
+        part, slope, varied = _plain_step(
+            u, v, acc, u_b, v_b, acc_b, work, slope, h, im, k, c, keys, springs, walls, drag
         )
-        slope = _slopes(u_b, v_b, acc_b, work[6], im, k, c, keys, springs, walls, drag)
         increment += part
         event = event or varied
         u, u_b = u_b, u
@@ -189,19 +187,22 @@ def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag):
     return increment, event, slope
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, forceinline=True)
 def _plain_step(
     x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt, im, k, c, keys, springs, walls, drag
 ):
-    """One plain RK4 step from the state in x (slopes ``x_acc``, ``slope``) into y.
-    Returns (dissipated energy, end slope, whether a contact opened or closed)."""
+    """One RK4 step from the state in x (slopes ``x_acc``, ``slope``) into y. Returns
+    (dissipated energy, end slope, whether the number of closed contacts varied).
+
+    The plain steps and the substeps: numba compiles it once, LLVM inlines it at every
+    call (forceinline; inline="always" made numba type and lower each copy anew)."""
     buffers = (work[0], work[1], work[2], work[3], work[4], y_u, y_v)
     force = work[6]
     increment, varied = _rk4(
         x_u, x_v, x_acc, slope, dt, buffers, force, im, k, c, keys, springs, walls, drag
     )
     end = _slopes(y_u, y_v, y_acc, force, im, k, c, keys, springs, walls, drag)
-    return increment, end, varied or end[2] != slope[2]
+    return increment, end, varied
 
 
 # Inlined, as _hand_back below: compiled on its own, each was lowered and optimised
@@ -333,16 +334,16 @@ def _integrate_part(
         target = min(n_steps, (step // record_every + 1) * record_every)
         while refine == 0 and step < target and not reached:
             if in_y:
-                increment, end, event = _plain_step(
+                increment, end, varied = _plain_step(
                     y_u, y_v, y_acc, x_u, x_v, x_acc, work, slope, dt,
                     im, k, c, keys, springs, walls, drag,
                 )  # fmt: skip
             else:
-                increment, end, event = _plain_step(
+                increment, end, varied = _plain_step(
                     x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt,
                     im, k, c, keys, springs, walls, drag,
                 )  # fmt: skip
-            if event:  # redone in substeps below
+            if varied or end[2] != slope[2]:  # redone in substeps below
                 refine = EVENT_AFTERMATH + 1
             else:
                 step += 1

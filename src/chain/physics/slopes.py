@@ -11,21 +11,11 @@ absent terms (``c``, ``walls``, ``drag`` None) left out.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numba
 import numpy as np
 from numba import types
-from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import overload
-
-# numba's pedantic SSA check flags every loop variable of an overload inlined at the IR
-# level (_link_terms) as "not in scope" while it compiles these kernels; the compiled
-# code is right (tests/test_kernels.py: bit-identical to the general kernel with walls,
-# drag, springs and damping). Only that message, only while compiling.
-warnings.filterwarnings(
-    "ignore", message=r"variable '.*' is not in scope", category=NumbaIRAssumptionWarning
-)
 
 
 @numba.njit(cache=True, inline="always")
@@ -161,7 +151,7 @@ def _link_terms(u, v, acc, force, im, k, c, keys, springs, left, right, power, c
     when numba compiles)."""
 
 
-@overload(_link_terms, inline="always")
+@overload(_link_terms, jit_options={"forceinline": True})
 def _link_terms_overload(
     u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark
 ):
