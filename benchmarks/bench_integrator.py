@@ -148,8 +148,8 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
     if not refine:  # detect events (same work, refined code present) but keep the coarse step
         edits.append(
             (
-                "            if varied or end[2] != slope[2]:  # redone in substeps below\n",
-                "            if (varied or end[2] != slope[2]) and dt < 0.0:  # never true\n",
+                "                if event:  # redone in substeps below\n",
+                "                if event and dt < 0.0:  # never true; numba cannot know it\n",
             )
         )
     for old, new in edits:
