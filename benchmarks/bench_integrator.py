@@ -4,6 +4,7 @@ Run from the repository root::
 
     python benchmarks/bench_integrator.py              # best of 7 interleaved runs
     python benchmarks/bench_integrator.py --repeat 9 --skip-long
+    python benchmarks/bench_integrator.py --baseline /tmp/k9fb/src   # and 9fb9b1b's
 
 It prints, for one collision in the paper's chain (N = 26, +V0 / -V0 at V0 = 0.3 m/s,
 2 ms simulated, records every 1 us, the default step):
@@ -13,7 +14,9 @@ It prints, for one collision in the paper's chain (N = 26, +V0 / -V0 at V0 = 0.3
    energy check), against a plain C RK4 (``benchmarks/c/rk4_chain.c``, compiled now
    with ``cc -O3 -march=native``; skipped with a message when there is no compiler)
    at the same step; also ``integrate`` (the lean kernel behind it) and the general
-   reference kernel against C; elastic and Kuwabara-Kono;
+   reference kernel against C; elastic and Kuwabara-Kono; with ``--baseline SRC``,
+   also ``chain.simulate`` of another commit's source tree (its package loaded under
+   another name), interleaved in the same rounds, and whether it gives the same bits;
    then (1b) the lean kernel carrying walls of zero stiffness, and a negligible track
    friction, against itself without them: what a term costs when numba compiles it in
    (reported, no target; 7.1 and 3.3 before 27 Nov 2026, when these terms cost
@@ -145,8 +148,8 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
     if not refine:  # detect events (same work, refined code present) but keep the coarse step
         edits.append(
             (
-                "            if event:  # redone in substeps below\n",
-                "            if event and dt < 0.0:  # never true; numba cannot know it\n",
+                "                if event:  # redone in substeps below\n",
+                "                if event and dt < 0.0:  # never true; numba cannot know it\n",
             )
         )
     for old, new in edits:
@@ -162,12 +165,31 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
     return module
 
 
+def baseline_package(src: Path):
+    """The ``chain`` package of the source tree ``src`` (another commit's), copied and
+    imported as ``chain_baseline`` beside this tree's; returns it."""
+    folder = Path(tempfile.mkdtemp())
+    shutil.copytree(
+        src / "chain", folder / "chain_baseline", ignore=shutil.ignore_patterns("__pycache__")
+    )
+    for path in (folder / "chain_baseline").rglob("*.py"):
+        text = path.read_text()
+        text = text.replace("from chain.", "from chain_baseline.").replace(
+            "from chain import", "from chain_baseline import"
+        )
+        text = text.replace("import chain.", "import chain_baseline.")
+        path.write_text(text.replace('"chain.', '"chain_baseline.'))  # lazy imports
+    sys.path.insert(0, str(folder))
+    return importlib.import_module("chain_baseline")
+
+
 def kernel_against_c(args, c_function) -> dict:
     """Section 1: chain.simulate (defaults), the lean and the reference kernel against C
     at the default step; returns {label: (simulate / C, integrate / C)}."""
     results = {}
     folder = tempfile.mkdtemp()
     unrefined = patched_kernel(Path(folder), EVENT_SUBSTEPS, EVENT_AFTERMATH, False)
+    old = None if args.baseline is None else baseline_package(args.baseline)
     for eta in (0.0, ETA):
         model = uniform_chain(N_BEADS, eta=eta)
         velocity = launch_velocities(model, SPEED, SPEED)
@@ -190,6 +212,11 @@ def kernel_against_c(args, c_function) -> dict:
         if c_function is not None:
             contenders["C"] = lambda v=velocity[0], e=eta, d=dt, s=n_steps, r=every: c_run(
                 c_function, v, e, d, s, r
+            )
+        if old is not None:
+            old_model = old.uniform_chain(N_BEADS, eta=eta)
+            contenders["baseline"] = lambda m=old_model: old.simulate(
+                m, SPEED, SPEED, duration=DURATION
             )
         for function in contenders.values():
             function()  # compile
@@ -217,6 +244,15 @@ def kernel_against_c(args, c_function) -> dict:
                 f"reference / C = {best['reference'] / best['C']:.2f}"
             )
             print_bound(best)
+        if "baseline" in best:
+            same = np.array_equal(
+                contenders["simulate"]().contact_force, contenders["baseline"]().contact_force
+            )
+            print(
+                f"  ** simulate / baseline ({args.baseline}) = "
+                f"{best['simulate'] / best['baseline']:.3f}; baseline / C = "
+                f"{best['baseline'] / best['C']:.2f}; same contact forces: {same}"
+            )
     shutil.rmtree(folder, ignore_errors=True)
     return results
 
@@ -481,6 +517,9 @@ def main() -> None:
         "--repeat", type=int, default=MIN_REPEAT, help=f"interleaved rounds (>= {MIN_REPEAT})"
     )
     parser.add_argument("--skip-long", action="store_true", help="skip section 4")
+    parser.add_argument(
+        "--baseline", type=Path, help="another commit's src/, timed in section 1 too"
+    )
     parser.add_argument("--long-child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.long_child:

@@ -26,7 +26,7 @@ SECOND = """\
 import toy_kernel as toy
 from chain.physics import compile_once
 print("calling", flush=True)
-result = compile_once.call(toy.twice, 1.5)
+result = compile_once.shared(toy.twice)(1.5)
 stats = toy.twice.stats
 print(result, sum(stats.cache_hits.values()), sum(stats.cache_misses.values()), flush=True)
 """
@@ -69,5 +69,56 @@ def test_a_kernel_without_cache_is_called_without_a_lock():
     def add(a, b):
         return a + b
 
-    assert compile_once.call(add, 2, 3) == 5
+    assert compile_once.shared(add)(2, 3) == 5
     assert len(add.overloads) == 1
+
+
+#: One job on a node: imports, says so, waits for the go, simulates the paper's
+#: collision on a short chain, reports how numba got the step loop (compiled: a cache
+#: miss; loaded: a hit) and a digest of the forces.
+JOB = """\
+import hashlib, sys
+from chain.physics import kernels
+from chain.physics.builders import uniform_chain
+from chain.physics.simulation import simulate
+print("ready", flush=True)
+sys.stdin.readline()
+result = simulate(uniform_chain(8), 0.3, 0.3, duration=2e-4)
+stats = kernels._integrate_part.stats
+digest = hashlib.sha256(result.contact_force.tobytes()).hexdigest()
+print(sum(stats.cache_misses.values()), sum(stats.cache_hits.values()), digest, flush=True)
+"""
+
+
+def test_jobs_on_a_node_with_an_empty_cache_compile_the_kernel_once(tmp_path):
+    """Three jobs start together on a node whose numba cache (NUMBA_CACHE_DIR, empty)
+    lacks the kernel: one compiles it, the two others wait for it and load it from
+    the cache, and all three get the same bits. No clock: every job has imported the
+    library before any of them is let go, and each waits on the lock, not a delay.
+    (Without chain.physics.compile_once all three compiled: three misses.)"""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    jobs = [
+        subprocess.Popen(
+            [sys.executable, "-c", JOB],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        for _ in range(3)
+    ]
+    for job in jobs:
+        assert job.stdout.readline().strip() == "ready", job.stderr.read()
+    for job in jobs:
+        job.stdin.write("go\n")
+        job.stdin.flush()
+    reports = []
+    for job in jobs:
+        out, err = job.communicate(timeout=900)
+        assert job.returncode == 0, err[-3000:]
+        reports.append(out.split())
+    assert sorted(int(misses) for misses, _, _ in reports) == [0, 0, 1], reports
+    assert sorted(int(hits) for _, hits, _ in reports) == [0, 1, 1], reports
+    assert len({digest for _, _, digest in reports}) == 1
+    assert list((tmp_path / "numba").rglob("*_integrate_part*.nbi"))  # the cache is there

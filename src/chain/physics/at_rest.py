@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from chain.physics import compile_once
 from chain.physics.kernels import _OK, QUIET_MARGIN, _integrate_one, _integrate_part
 from chain.physics.model import SPRING
 
@@ -139,8 +138,7 @@ def integrate_launch(u, v, params, dt, n_steps, record_every, links, particles, 
         beads = np.r_[0:q0, q1 : u.shape[0]]
         short_u, short_v = u[beads], v[beads]
         record = (_compact_record(links, span, q0 - 1), _compact_record(particles, span, q0))
-        status, step, refined, refine, dissipated, reached = compile_once.call(
-            _integrate_part,
+        status, step, refined, refine, dissipated, reached = _integrate_part(
             short_u, short_v, _compact_params(params, span), dt, step, n_steps,
             record_every, *record, outputs, refine, refined, dissipated, q0,
         )  # fmt: skip
@@ -149,8 +147,7 @@ def integrate_launch(u, v, params, dt, n_steps, record_every, links, particles, 
             return status, step, refined
         span = _shrunk(u, v, span)
     whole = ((links, np.arange(links.size)), (particles, np.arange(particles.size)))
-    status, step, refined, *_ = compile_once.call(
-        _integrate_part,
+    status, step, refined, *_ = _integrate_part(
         u, v, params, dt, step, n_steps, record_every, *whole, outputs,
         refine, refined, dissipated, -1,
     )  # fmt: skip

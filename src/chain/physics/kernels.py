@@ -21,8 +21,8 @@ what changed is the bookkeeping around the arithmetic:
   branch on the link kind (every link as a Hertz contact, the bonded sensor springs
   over them, then the accelerations), so that numba's LLVM computes several links per
   SIMD instruction; the Kuwabara-Kono term is one flag per model.
-* **Plain steps in a loop of their own**, the refined steps outside it (see
-  _integrate_part).
+* **One RK4 step for plain steps and substeps** (see _integrate_part), compiled once
+  by numba and inlined by LLVM where it is called.
 * **Only what is asked is recorded**: chosen links and particles, the two wall
   forces, the energies and the momentum. The state is checked for non-finite values
   at recorded samples only (a non-finite value never becomes finite again).
@@ -148,7 +148,7 @@ def _record(u, v, dissipated, model, links, particles, sample, outputs):
     return finite
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _potential_energy(u, k, kind, walls):
     n = u.shape[0]
     energy = 0.0
@@ -161,69 +161,29 @@ def _potential_energy(u, k, kind, walls):
     return _wall_energy(u, walls, energy)
 
 
-@numba.njit(cache=True)
-def _substeps(x, acc, slope, dt, work, im, k, c, keys, springs, walls, drag):
-    """EVENT_SUBSTEPS RK4 steps from the state x = (u, v, spare u, spare v) whose
-    slopes are (``acc``, ``slope``); the end state is left in x[0], x[1] and ``acc``.
-    Returns (dissipated energy, event seen, end slope)."""
-    u, v, u_b, v_b = x
-    acc_b = work[5]
-    h = dt / EVENT_SUBSTEPS
-    increment = 0.0
-    event = False
-    for _ in range(EVENT_SUBSTEPS):
-        buffers = (work[0], work[1], work[2], work[3], work[4], u_b, v_b)
-        part, varied = _rk4(
-            u, v, acc, slope, h, buffers, work[6], im, k, c, keys, springs, walls, drag
-        )
-        slope = _slopes(u_b, v_b, acc_b, work[6], im, k, c, keys, springs, walls, drag)
-        increment += part
-        event = event or varied
-        u, u_b = u_b, u
-        v, v_b = v_b, v
-        acc, acc_b = acc_b, acc
-    if EVENT_SUBSTEPS % 2 == 1:  # the end state is in the spare buffers
-        _copy_into(u_b, u)
-        _copy_into(v_b, v)
-        _copy_into(acc_b, acc)
-    return increment, event, slope
-
-
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, forceinline=True)
 def _plain_step(
     x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt, im, k, c, keys, springs, walls, drag
 ):
-    """One plain RK4 step from the state in x (slopes ``x_acc``, ``slope``) into y.
-    Returns (dissipated energy, end slope, whether a contact opened or closed)."""
+    """One RK4 step from the state in x (slopes ``x_acc``, ``slope``) into y. Returns
+    (dissipated energy, end slope, whether the number of closed contacts varied).
+
+    The plain steps and the substeps: numba compiles it once, LLVM inlines it at every
+    call (forceinline; inline="always" made numba type and lower each copy anew)."""
     buffers = (work[0], work[1], work[2], work[3], work[4], y_u, y_v)
-    force = work[6]
+    force = work[5]
     increment, varied = _rk4(
         x_u, x_v, x_acc, slope, dt, buffers, force, im, k, c, keys, springs, walls, drag
     )
     end = _slopes(y_u, y_v, y_acc, force, im, k, c, keys, springs, walls, drag)
-    return increment, end, varied or end[2] != slope[2]
+    return increment, end, varied
 
 
-# Inlined, as _hand_back below: compiled on its own, each was lowered and optimised
-# once more with everything it calls (a cold compile 38.6 -> 31.8 s for both kinds of
-# model with the changes of _integrate_one; best of 3 interleaved; same bits and speed).
-@numba.njit(cache=True, inline="always")
-def _refined_step(x_u, x_v, x_acc, y_u, y_v, work, slope, dt, im, k, c, keys, springs, walls, drag):
-    """The step from the state in x redone in EVENT_SUBSTEPS substeps, end state in x.
-    Returns (dissipated energy, end slope, whether a contact opened or closed)."""
-    increment, varied, end = _substeps(
-        (x_u, x_v, y_u, y_v), x_acc, slope, dt, work, im, k, c, keys, springs, walls, drag
-    )
-    return increment, end, varied or end[2] != slope[2]
-
-
-# The step loop is split in two: plain steps in a tight inner loop that runs until a
-# contact event or the next record, and the refined steps outside it. With both kinds
-# of step in one loop body (as before), the plain steps ran 1.3x slower although the
-# refined code never ran in most steps (measured: 7.25 against 5.57 ms for the paper's
-# collision with the refinement present but switched off). Each step is inlined at two
-# call sites, one per order of the arrays, so that the loop never swaps array
-# variables: a swap costs reference-count updates. Bits unchanged.
+# A refined step is EVENT_SUBSTEPS plain steps of dt / EVENT_SUBSTEPS through the same
+# code, which numba compiled once more (and in a function of its own) before: one copy
+# fewer of the step to compile, the same speed. The step is inlined at two call sites,
+# one per order of the arrays, so that the loop never swaps array variables: a swap
+# costs reference-count updates. Bits unchanged.
 
 
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
@@ -238,10 +198,9 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     literal argument would compile it again)."""
     links = (links, np.arange(links.shape[0]))
     particles = (particles, np.arange(particles.shape[0]))
-    status, step, refined, _, _, _ = compile_once.call(
-        _integrate_part,
-        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1,
-    )  # fmt: skip
+    status, step, refined, _, _, _ = _integrate_part(
+        u, v, params, dt, 0, n_steps, record_every, links, particles, outputs, 0, 0, 0.0, -1
+    )
     return status, step, refined
 
 
@@ -261,28 +220,6 @@ def _reached(u, v, gap, spread):
 
 
 @numba.njit(cache=True, inline="always")
-def _reached_in(in_y, x_u, x_v, y_u, y_v, gap, spread):
-    """_reached on the state (in y or in x); False when there is no ``gap`` (-1)."""
-    if gap < 0:
-        return False
-    return _reached(y_u, y_v, gap, spread) if in_y else _reached(x_u, x_v, gap, spread)
-
-
-@numba.njit(cache=True, inline="always")
-def _refined_state(
-    in_y, x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt, im, k, c, keys, springs, walls, drag
-):
-    """_refined_step from the state (in y or in x), which stays where it is."""
-    if in_y:
-        return _refined_step(
-            y_u, y_v, y_acc, x_u, x_v, work, slope, dt, im, k, c, keys, springs, walls, drag
-        )
-    return _refined_step(
-        x_u, x_v, x_acc, y_u, y_v, work, slope, dt, im, k, c, keys, springs, walls, drag
-    )
-
-
-@numba.njit(cache=True, inline="always")
 def _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status):
     """The state reached (in y or in x) into (u, v); returns the status, set to
     _NOT_FINITE if it was _OK and the state is not finite."""
@@ -298,13 +235,13 @@ def _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status):
 
 @numba.njit(cache=True, inline="always")
 def _work_buffers(n):
-    """Five RK4 buffers, the spare accelerations of the substeps, the link forces."""
+    """Five RK4 buffers and the link forces."""
     return (
-        np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
-        np.empty(max(n - 1, 1)),
+        np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(max(n - 1, 1))
     )  # fmt: skip
 
 
+@compile_once.shared
 @numba.njit(cache=True, nogil=True)
 def _integrate_part(
     u, v, params, dt, step, n_steps, record_every, links, particles, outputs,
@@ -323,7 +260,7 @@ def _integrate_part(
     work = _work_buffers(n)
     x_u, x_v, x_acc = u.copy(), v.copy(), np.empty(n)
     y_u, y_v, y_acc = np.empty(n), np.empty(n), np.empty(n)
-    slope = _slopes(x_u, x_v, x_acc, work[6], im, k, c, keys, springs, walls, drag)
+    slope = _slopes(x_u, x_v, x_acc, work[5], im, k, c, keys, springs, walls, drag)
     if step == 0:  # sample 0, as int64: a literal 0 compiled _record a second time
         _record(x_u, x_v, dissipated, recorded, links, particles, step, outputs)
     status = _OK
@@ -331,36 +268,46 @@ def _integrate_part(
     reached = False
     while step < n_steps and status == _OK and not reached:
         target = min(n_steps, (step // record_every + 1) * record_every)
-        while refine == 0 and step < target and not reached:
-            if in_y:
-                increment, end, event = _plain_step(
-                    y_u, y_v, y_acc, x_u, x_v, x_acc, work, slope, dt,
-                    im, k, c, keys, springs, walls, drag,
-                )  # fmt: skip
-            else:
-                increment, end, event = _plain_step(
-                    x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt,
-                    im, k, c, keys, springs, walls, drag,
-                )  # fmt: skip
-            if event:  # redone in substeps below
-                refine = EVENT_AFTERMATH + 1
-            else:
-                step += 1
+        while step < target and not reached:
+            # A plain step, or the step redone in EVENT_SUBSTEPS substeps: the same RK4
+            # step, from x into y or back (an even count of substeps ends where it began).
+            substeps = 1 if refine == 0 else EVENT_SUBSTEPS
+            h = dt / substeps
+            increment = 0.0  # 0.0 + x is x here: dissipated is never -0.0 (same bits)
+            varied = False
+            end = slope
+            for _ in range(substeps):
+                if in_y:
+                    part, end, changed = _plain_step(
+                        y_u, y_v, y_acc, x_u, x_v, x_acc, work, end, h,
+                        im, k, c, keys, springs, walls, drag,
+                    )  # fmt: skip
+                else:
+                    part, end, changed = _plain_step(
+                        x_u, x_v, x_acc, y_u, y_v, y_acc, work, end, h,
+                        im, k, c, keys, springs, walls, drag,
+                    )  # fmt: skip
+                increment += part
+                varied = varied or changed
                 in_y = not in_y
-                dissipated += increment
-                slope = end
-                if gap >= 0:  # (tested here: inside the helper it cost 5 %)
-                    reached = _reached(y_u, y_v, gap, 4) if in_y else _reached(x_u, x_v, gap, 4)
-        if refine > 0 and step < target and not reached:
-            increment, slope, event = _refined_state(
-                in_y, x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt,
-                im, k, c, keys, springs, walls, drag,
-            )  # fmt: skip
-            refine = EVENT_AFTERMATH if event else refine - 1
-            refined += 1
+            event = varied or end[2] != slope[2]
+            if refine == 0:
+                if event:  # redone in substeps below
+                    in_y = not in_y  # the state is where it was
+                    refine = EVENT_AFTERMATH + 1
+                    continue
+            else:
+                refine = EVENT_AFTERMATH if event else refine - 1
+                refined += 1
             step += 1
             dissipated += increment
-            reached = _reached_in(in_y, x_u, x_v, y_u, y_v, gap, 4 * EVENT_SUBSTEPS)
+            slope = end
+            if gap >= 0:  # (tested here: inside the helper it cost 5 %)
+                spread = 4 * substeps  # beads a (sub)step moves a disturbance by, at most
+                if in_y:
+                    reached = _reached(y_u, y_v, gap, spread)
+                else:
+                    reached = _reached(x_u, x_v, gap, spread)
         if step % record_every == 0 and step == target:
             sample = step // record_every
             # Written out: as a helper taking the state's place, the kernel ran 4 % slower.

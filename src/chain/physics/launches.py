@@ -12,7 +12,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from chain.physics import compile_once, reference_kernel
+from chain.physics import reference_kernel
 from chain.physics.at_rest import integrate_launch
 from chain.physics.model import HERTZ, SPRING, ChainModel
 
@@ -135,8 +135,7 @@ def _reference_launches(model: ChainModel, run, n_samples: int, links, particles
     outputs = [None] * 5
 
     def launch() -> None:
-        compile_once.call(
-            reference_kernel._integrate_batch,
+        reference_kernel._integrate_batch(
             displacement, velocity, params, dt, n_steps, record_every, *full, *report,
         )  # fmt: skip
         link_force, wall_force, recorded_velocity, energy, momentum = full

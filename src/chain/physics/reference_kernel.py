@@ -15,7 +15,7 @@ import math
 import numba
 import numpy as np
 
-from chain.physics import kernel_cache
+from chain.physics import compile_once, kernel_cache
 from chain.physics.kernels import _NOT_FINITE, _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
 
 
@@ -233,6 +233,7 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, outputs):
     return _OK, n_steps, refined
 
 
+@compile_once.shared
 @numba.njit(cache=True, parallel=True)
 def _integrate_batch(
     u,

@@ -11,21 +11,11 @@ absent terms (``c``, ``walls``, ``drag`` None) left out.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numba
 import numpy as np
 from numba import types
-from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import overload
-
-# numba's pedantic SSA check flags every loop variable of an overload inlined at the IR
-# level (_link_terms) as "not in scope" while it compiles these kernels; the compiled
-# code is right (tests/test_kernels.py: bit-identical to the general kernel with walls,
-# drag, springs and damping). Only that message, only while compiling.
-warnings.filterwarnings(
-    "ignore", message=r"variable '.*' is not in scope", category=NumbaIRAssumptionWarning
-)
 
 
 @numba.njit(cache=True, inline="always")
@@ -161,13 +151,20 @@ def _link_terms(u, v, acc, force, im, k, c, keys, springs, left, right, power, c
     when numba compiles)."""
 
 
-@overload(_link_terms, inline="always")
+# The overload's implementation is compiled anew for every set of compile flags of its
+# callers (the step loop's differ from the step's), so it only hands over to a kernel
+# compiled once: the links' loop was compiled twice per kind before.
+@overload(_link_terms, jit_options={"forceinline": True})
 def _link_terms_overload(
     u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark
 ):
-    return _elastic_links if c is types.none else _damped_links
+    links = _elastic_links if c is types.none else _damped_links
+    return lambda u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark: (
+        links(u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark)
+    )
 
 
+@numba.njit(cache=True, forceinline=True)
 def _elastic_links(u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark):
     # In passes, so that the first has no branch and vectorises (SIMD: several links per
     # instruction): every link as a Hertz contact (an open one, delta <= 0, gives
@@ -201,6 +198,7 @@ def _elastic_links(u, v, acc, force, im, k, c, keys, springs, left, right, power
     return power, closed, mark
 
 
+@numba.njit(cache=True, forceinline=True)
 def _damped_links(u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark):
     n = u.shape[0]
     previous = left
