@@ -60,10 +60,13 @@ from measure import (
     C_FLAGS,
     MIN_REPEAT,
     Conditions,
+    Figure,
+    OtherProcesses,
     best_times,
     load_c,
     machine,
     peak_memory_mb,
+    write_result,
 )
 from measure import c_run as c_run_equal
 from scipy.integrate import solve_ivp
@@ -238,6 +241,8 @@ def kernel_against_c(args, c_function) -> dict:
                 + (f", C {np.abs(energy - energy[0]).max() / energy[0]:.1e}" if not eta else "")
             )
             results[label] = (best["simulate"] / best["C"], best["integrate"] / best["C"])
+        if old is not None:
+            results[f"{label} / baseline"] = best["simulate"] / best["baseline"]
             print(
                 f"  ** simulate / C = {results[label][0]:.2f} (target <= 1.3); "
                 f"integrate / C = {results[label][1]:.2f}; "
@@ -532,7 +537,7 @@ def main() -> None:
         f", numba {numba.__version__}; C flags: {' '.join(C_FLAGS)}"
     )
     conditions.sample("before")
-    with tempfile.TemporaryDirectory() as folder:
+    with tempfile.TemporaryDirectory() as folder, OtherProcesses(interval=1.0) as others:
         c_function, how = load_c(folder)
         print(f"C yardstick: {how}" if c_function else f"C yardstick skipped: {how}")
         print("\n== 1. chain.simulate / C, one collision, N = 26, V0 = 0.3 m/s, 2 ms, 1 us")
@@ -549,6 +554,10 @@ def main() -> None:
             long = long_chain(args)
     conditions.sample("after")
     print(f"\n== summary (measured in this run, best of {args.repeat} interleaved)")
+    baselines = {k: ratios.pop(k) for k in list(ratios) if k.endswith(" / baseline")}
+    for label, ratio in baselines.items():
+        verdict = conditions.verdict(ratio <= 1.0)
+        print(f"chain.simulate ({label}): {ratio:.3f}  (target <= 1: {verdict})")
     for label, (user, kernel) in ratios.items():
         verdict = conditions.verdict(user <= 1.3)
         print(f"chain.simulate / C ({label}): {user:.2f}  (target <= 1.3: {verdict})")
@@ -565,6 +574,47 @@ def main() -> None:
             f"< 4 s: {conditions.verdict(seconds < 4)}; < 300 MB: "
             f"{'met' if megabytes < 300 else 'not met'}, memory is not load-dependent)"
         )
+    long = None if args.skip_long else long
+    figures = summary_figures(args, ratios, baselines, terms, dop, long, conditions)
+    write_result("bench_integrator", figures, conditions, others.share)
+
+
+def summary_figures(args, ratios, baselines, terms, dop, long, conditions) -> list:
+    """The summary's figures, for benchmarks/results/bench_integrator.json."""
+    c = f"C RK4 ({' '.join(C_FLAGS)}), same run"
+    figures = []
+    for label, (user, kernel) in ratios.items():
+        figures += [
+            Figure(f"chain.simulate / C ({label})", user, "x",
+                   "plain RK4 steps plus contact-event detection and refinement", c,
+                   "<= 1.3", conditions.verdict(user <= 1.3)),
+            Figure(f"integrate (lean kernel) / C ({label})", kernel, "x",
+                   "the kernel's steps (no fused multiply-add: same bits)", c),
+        ]  # fmt: skip
+    for label, ratio in baselines.items():
+        figures.append(
+            Figure(f"chain.simulate ({label})", ratio, "x", "the same RK4 steps",
+                   f"{args.baseline}'s chain.simulate, same run", "<= 1",
+                   conditions.verdict(ratio <= 1.0))
+        )  # fmt: skip
+    figures += [
+        Figure("kernel with walls / without", terms["walls"], "x", "the term compiled in",
+               "the kernel without walls, same run"),
+        Figure("kernel with track friction / without", terms["drag"], "x",
+               "the term compiled in", "the kernel without friction, same run"),
+        Figure("DOP853 / kernel", dop, "x", "scipy's step overhead",
+               "the kernel at the same accuracy, same run"),
+    ]  # fmt: skip
+    if long is not None:
+        seconds, megabytes = long["simulate_cpu_s"], long["peak_mb"]
+        figures += [
+            Figure(f"{LONG_N} beads x 5 ms, CPU", seconds, "s", "the beads the waves reach",
+                   None, "< 4 s", conditions.verdict(seconds < 4)),
+            Figure(f"{LONG_N} beads x 5 ms, peak memory", megabytes, "MB",
+                   "interpreter, numba, record", None, "< 300 MB",
+                   "met" if megabytes < 300 else "not met"),
+        ]  # fmt: skip
+    return figures
 
 
 if __name__ == "__main__":

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 from bench_integrator import c_run, dop853, patched_kernel
-from measure import C_FLAGS, MIN_REPEAT, Conditions, best_times, load_c
+from measure import C_FLAGS, MIN_REPEAT, Conditions, Figure, best_times, load_c, write_result
 
 from chain.physics import kernels
 from chain.physics.builders import uniform_chain
@@ -182,6 +182,13 @@ def main() -> None:
                 f"{seconds / plain:.1f} (the ceiling if the wrappers, recording and "
                 "refinement cost nothing)"
             )
+    if "C" in best:
+        c = f"C RK4 ({' '.join(C_FLAGS)}), same run"
+        figures = [Figure("simulate() / C", total / best["C"], "x", "the parts below", c)]
+        figures += [
+            Figure(k, v / best["C"], "x", "its share of simulate()", c) for k, v in parts.items()
+        ]
+        write_result("kernel_breakdown" + ("_damped" if args.eta else ""), figures, conditions)
 
 
 if __name__ == "__main__":
