@@ -1,6 +1,5 @@
 """What a user waits for: the paper run, a forced rebuild, three what-ifs and the tests
-(issues 33, 52), each with its job count, against its target; and what the job server
-saves (issue 53).
+(issues 33, 52), each with its job count, against its target.
 
 Every round works in a fresh copy of the checkout (the files git tracks, no numba cache,
 no results, no result store: a fresh clone), whose ``src`` the jobs import, and runs in
@@ -12,10 +11,6 @@ order::
     brass       snakemake --cores 2 --configfile whatif/brass.yaml     after the paper run
     analysis    an overlay: run_name bench_analysis, analysis: {main_estimator: peak}
     figure      an overlay: run_name bench_figure, figures: {representative_force_N: 100}
-
-then, in a second fresh copy, ``paper``, ``forced`` and ``figure`` again with every job
-in its own process (``HERTZCHAIN_JOB_SERVER=off``): the server's saving on the cold and
-the warm paper run and on the figure what-if, measured in the same round.
 
 The targets are issue 33's, in seconds on the machine it was measured on. Each round
 also runs a **yardstick**: the paper run of the commit the issue measured
@@ -87,10 +82,6 @@ SCENARIOS = (
     ("figure", ["--configfile", "bench_figure.yaml"],
      "run_name: bench_figure\nfigures: {representative_force_N: 100}\n", 10.0, None),
 )  # fmt: skip
-#: Scenarios run again with every job in its own process (a copy of their own).
-WITHOUT_SERVER = ("paper", "forced", "figure")
-#: Below this saving of the warm paper run, issue 53 removes the job server.
-SERVER_WORTH = 0.15
 #: The commit issue 33 measured (113 s for the paper run, fresh clone, ``.[test]``, 2
 #: cores) and that time, s: the yardstick that scales the targets to this machine.
 BASELINE_COMMIT = "9fb9b1b"
@@ -169,12 +160,10 @@ def copy_commit(commit: str, work: Path) -> None:
     subprocess.run(["tar", "-x", "-C", str(work)], input=archive, check=True)
 
 
-def environment(work: Path, server: bool = True) -> dict:
-    """The environment of a run in the copy: its jobs import the copy's library (and
-    each runs in its own process unless ``server``)."""
+def environment(work: Path) -> dict:
+    """The environment of a run in the copy: its jobs import the copy's library."""
     path = os.pathsep.join([str(work / "src"), os.environ.get("PYTHONPATH", "")])
-    off = {} if server else {"HERTZCHAIN_JOB_SERVER": "off"}
-    return {**os.environ, "PYTHONPATH": path, **off}
+    return {**os.environ, "PYTHONPATH": path}
 
 
 @dataclass(frozen=True)
@@ -190,13 +179,13 @@ class Timed:
         return self.others <= MAX_OTHER_SHARE
 
 
-def run(command: list[str], work: Path, server: bool = True) -> tuple[Timed, str]:
+def run(command: list[str], work: Path) -> tuple[Timed, str]:
     """Run ``command`` in the copy; its time and what it printed."""
     start = time.perf_counter()
     with OtherProcesses() as others:
         done = subprocess.run(
-            command, cwd=work, capture_output=True, text=True,
-            env=environment(work, server), stdin=subprocess.DEVNULL,
+            command, cwd=work, capture_output=True, text=True, env=environment(work),
+            stdin=subprocess.DEVNULL,
         )  # fmt: skip
     elapsed = Timed(time.perf_counter() - start, others.share)
     if done.returncode != 0:
@@ -216,25 +205,19 @@ def yardstick(work: Path, cores: int) -> Timed:
 
 
 def one_round(work: Path, cores: int) -> dict:
-    """Every scenario once, in order, in a fresh copy, then :data:`WITHOUT_SERVER` in
-    another: name -> (wall s, its jobs)."""
+    """Every scenario once, in order, in a fresh copy: name -> (wall s, its jobs)."""
+    copy_checkout(work)
     timings = {}
-    for server in (True, False):
-        folder = work / ("server" if server else "own_processes")
-        copy_checkout(folder)
-        for name, args, overlay, _, _ in SCENARIOS:
-            if not server and name not in WITHOUT_SERVER:
-                continue
-            if overlay:
-                (folder / f"bench_{name}.yaml").write_text(overlay)
-            command = [sys.executable, "-m", "snakemake", "--cores", str(cores), *args]
-            timed, printed = run(command, folder, server)
-            jobs = jobs_of(printed, folder)
-            key = name if server else f"{name}, no server"
-            timings[key] = (timed, jobs)
-            print(f"  {key}: {timed.wall:.1f} s, {int(jobs['ran'].sum())} jobs run, "
-                  f"{int((~jobs['ran']).sum())} reused, other processes {timed.others:.1%} "
-                  f"of the CPU", flush=True)  # fmt: skip
+    for name, args, overlay, _, _ in SCENARIOS:
+        if overlay:
+            (work / f"bench_{name}.yaml").write_text(overlay)
+        command = [sys.executable, "-m", "snakemake", "--cores", str(cores), *args]
+        timed, printed = run(command, work)
+        jobs = jobs_of(printed, work)
+        timings[name] = (timed, jobs)
+        print(f"  {name}: {timed.wall:.1f} s, {int(jobs['ran'].sum())} jobs run, "
+              f"{int((~jobs['ran']).sum())} reused, other processes {timed.others:.1%} "
+              f"of the CPU", flush=True)  # fmt: skip
     return timings
 
 
@@ -319,7 +302,6 @@ def summarise(rounds: list[dict], scale: Timed | None) -> list[Figure]:
                 Figure(f"{name} / yardstick", timed.wall / scale.wall, "x", BOUNDS[name], ratio_to,
                        _target(*limits), _judged(here))
             )  # fmt: skip
-    figures += server_savings(rounds)
     analysis = rounds[-1]["analysis"][1]
     simulated = analysis[analysis["ran"] & analysis["rule"].isin(SIMULATIONS)]
     print(f"  analysis-only what-if ran {len(simulated)} simulation job(s) (target: none): "
@@ -329,27 +311,6 @@ def summarise(rounds: list[dict], scale: Timed | None) -> list[Figure]:
                "the jobs whose inputs the estimator does not change are reused", None,
                "0", "met" if simulated.empty else "not met")
     )  # fmt: skip
-    return figures
-
-
-def server_savings(rounds: list[dict]) -> list[Figure]:
-    """What the job server saves on each scenario of :data:`WITHOUT_SERVER`: 1 - (best
-    with) / (best without), interleaved in the same rounds. Issue 53 keeps the server
-    only if it saves :data:`SERVER_WORTH` of the warm paper run (``forced``)."""
-    figures = []
-    print("\nthe job server (every job in its own process without it):")
-    for name in WITHOUT_SERVER:
-        best = [min(r[key][0].wall for r in rounds) for key in (name, f"{name}, no server")]
-        saving = 1.0 - best[0] / best[1]
-        worth = f" (keep the server if >= {SERVER_WORTH:.0%})" if name == "forced" else ""
-        print(f"  {name:9s} {best[0]:6.1f} s with, {best[1]:6.1f} s without: "
-              f"saves {saving:.1%}{worth}")  # fmt: skip
-        figures.append(
-            Figure(f"{name}: job server's saving", 100 * saving, "%",
-                   "the imports each job's own process pays", f"{name} without the server",
-                   f">= {SERVER_WORTH:.0%}" if worth else "",
-                   ("met" if saving >= SERVER_WORTH else "not met") if worth else "")
-        )  # fmt: skip
     return figures
 
 
@@ -385,7 +346,7 @@ def main(argv=None) -> int:
         if not args.no_tests:
             conditions.sample("before the tests")
             tests = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
-            timed, printed = run(tests, work / "server")
+            timed, printed = run(tests, work)
             conditions.sample("after the tests")
             closing = printed.strip().splitlines()[-1]
             judged = verdict(timed, TESTS_TARGET_S, None)

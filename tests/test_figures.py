@@ -521,46 +521,6 @@ def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
     assert mode & 0o044, "figures must be readable by others (not left at mkstemp's 0600)"
 
 
-#: Fig. 4 from pickled tables, saved by a fresh interpreter: matplotlib cold.
-_COLD_SAVE = """
-import pickle, sys
-from chain.report.figures import style
-from chain.report.figures.fig4_delay_vs_force import fig4_delay_vs_force
-delays, fits, constants = pickle.load(open(sys.argv[1], "rb"))
-fig = fig4_delay_vs_force(delays, fits, constants=constants)
-style.save_figure(fig, sys.argv[2])
-"""
-
-
-def test_a_warmed_up_process_saves_the_bytes_of_a_cold_one(tmp_path):
-    """The figures' warm-up (chain.report.figures.warm_up, run in steps by the job
-    server before it forks the jobs) builds matplotlib's mathtext parser and loads the fonts
-    and the PDF backend: a figure saved after it has the bytes of one saved by a fresh
-    interpreter, PDF and PNG (Fig. 4: log axes and mathtext labels)."""
-    import pickle
-    import subprocess
-    import sys
-
-    from chain.report.figures.warm_up import warm_up_steps
-
-    constants = {"C_bal_paper_us_N16": 49.75, "C_bal_exact_us_N16": 37.74}
-    inputs = (delays_table(), delay_fits_table(), constants)
-    (tmp_path / "inputs.pickle").write_bytes(pickle.dumps(inputs))
-    cold = tmp_path / "cold" / "fig4"
-    done = subprocess.run(
-        [sys.executable, "-c", _COLD_SAVE, str(tmp_path / "inputs.pickle"), str(cold)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert done.returncode == 0, done.stderr[-3000:]
-    for step in warm_up_steps():
-        step()
-    warm = style.save_figure(
-        fig4_delay_vs_force(inputs[0], inputs[1], constants=inputs[2]), tmp_path / "warm" / "fig4"
-    )
-    for path in warm:
-        assert path.read_bytes() == (cold.parent / path.name).read_bytes(), path.name
 
 
 @pytest.mark.parametrize("figure", ["fig3", "fig4", "fig5", "parity"])

@@ -9,11 +9,8 @@ that first build (so that they may run at the same time, in pytest-xdist's worke
 * (the first build runs on 1 core and the interrupted rebuilds below on 2, which
   require the same bytes in every file of ``results/repro/`` but ``logs/`` and
   ``benchmarks/``, summary.md and the article included; a second build of every rule
-  under another ``PYTHONHASHSEED`` and without the job server, and a reused result
-  against a recomputed one, is test_workflow.py's
-  test_a_recomputed_run_gives_the_stored_bytes, on the tiny run; every build here runs
-  its jobs in the job server, chain.pipeline.job_server, so that the interruptions
-  below hit jobs run there);
+  under another ``PYTHONHASHSEED``, and a reused result against a recomputed one, is
+  test_workflow.py's test_a_recomputed_run_gives_the_stored_bytes, on the tiny run);
 * look for the temporary directory, the checkout's path and today's date in the files;
 * interrupt a ``--forceall`` rebuild as soon as a simulation output is being written
   (Ctrl-C), then the user's next command as soon as a table is being written (a

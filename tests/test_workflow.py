@@ -447,23 +447,16 @@ def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
 
 def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     """``--forceall`` recomputes every job of the tiny run (Snakemake's convention)
-    under another string-hash seed, each job in its own process
-    (``HERTZCHAIN_JOB_SERVER=off``; the tiny run's jobs ran in the job server,
-    chain.pipeline.job_server): every result has the bytes that were stored, so the
+    under another string-hash seed: every result has the bytes that were stored, so the
     store keeps its entries and names no difference. One run shows that a reused result
-    is the recomputed one, that a second build gives the same bytes and that the job
-    server changes none."""
+    is the recomputed one and that a second build gives the same bytes."""
     work, out, env, _ = checkout_copy(tiny[0], tmp_path)
     store = work / "results" / ".store"
     stored = sorted(p.name for p in store.glob("??/*"))
-    server_log = work / ".snakemake" / "job_server.log"
-    assert "job server: ready" in server_log.read_text()  # the tiny run's jobs used it
-    server_log.unlink()
     args = ["--forceall", "--cores", "2", "--configfile", str(TINY)]
-    result = run(args, work, {**env, "PYTHONHASHSEED": "2", "HERTZCHAIN_JOB_SERVER": "off"})
+    result = run(args, work, {**env, "PYTHONHASHSEED": "2"})
     output = result.stdout + result.stderr
     assert result.returncode == 0, output[-5000:]
-    assert not server_log.exists()
     assert "hertzchain store: forced, the results replace the stored: " in output
     assert "hertzchain store: 0 results reused" in output and "differ" not in output
     assert ran(out) == {str(p.relative_to(out / "logs")) for p in (out / "logs").rglob("*.log")}

@@ -11,7 +11,6 @@ from snakemake import __version__ as SNAKEMAKE_VERSION
 from snakemake.exceptions import WorkflowError
 from snakemake.scheduling.job_scheduler import JobScheduler
 
-from chain.pipeline import job_server
 from chain.pipeline.config import check_config
 from chain.pipeline.datasets import (
     DEFAULT_CACHE as DATASET_CHECK_CACHE,
@@ -27,17 +26,6 @@ from chain.pipeline.store import Store, StoreError
 check_config(config)
 PLAN = RunPlan(config)
 
-# The job server (chain.pipeline.job_server): a local run's jobs run in children of one
-# process that imported their libraries once. Started as soon as the config passed its
-# check, to import while Snakemake builds the DAG; the jobs learn its socket in
-# `onstart`, where the run is known to be local (a cluster run stops it there).
-SCRIPTS, SERVER_LOG = (
-    Path(workflow.basedir, "workflow", "scripts"),
-    ".snakemake/job_server.log",
-)
-JOB_SERVER = {}
-if workflow.is_main_process and not getattr(workflow.output_settings, "dryrun", True):
-    JOB_SERVER["server"] = job_server.start(SCRIPTS, SERVER_LOG)
 # The result store (chain.pipeline.reuse): no one else may write it, checked here.
 try:
     STORE = Store.open(os.environ)
@@ -128,12 +116,6 @@ def dag_jobs():
 
 
 onstart:
-    if workflow.local_exec and workflow.is_main_process:
-        if "server" not in JOB_SERVER:  # Snakemake's API without output settings
-            JOB_SERVER["server"] = job_server.start(SCRIPTS, SERVER_LOG)
-        job_server.publish(JOB_SERVER["server"])
-    else:
-        job_server.stop(JOB_SERVER.pop("server", None))
     # -F, -R, --forcerun: what Snakemake reruns, it computes (not from the store).
     flags = workflow.dag_settings
     forced = flags.forceall or bool(flags.forcerun) or flags.forcetargets
@@ -141,10 +123,8 @@ onstart:
 
 
 onsuccess:
-    job_server.stop(JOB_SERVER.pop("server", None))
     run_ended(OUT)
 
 
 onerror:
-    job_server.stop(JOB_SERVER.pop("server", None))
     run_ended(OUT)

@@ -2,7 +2,7 @@
 
 import json
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.report.text.article import article_numbers, compile_article

@@ -1,6 +1,6 @@
 """Every experiment dataset (measured-trace format) as a trace table (chain.apparatus.measured)."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 from _inputs import dataset_folders
 from _logging import start
 

@@ -3,7 +3,7 @@ the chain (chain.report.figures.fig5_ssw_vs_force)."""
 
 from pathlib import Path
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -1,7 +1,7 @@
 """One friction/rotation setting on one chain, run by LAMMPS and analysed
 (chain.studies.lammps_sweep.run_sweep_setting), with every estimator of the run."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.atomic import write_csv_atomic

@@ -1,6 +1,6 @@
 """Secondary solitary waves behind every crossed pulse (chain.analysis.ssw.ssw_table)."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _inputs import selection
 from _logging import start

@@ -1,6 +1,6 @@
 """Fits of SSW amplitude = slope x F_m (chain.analysis.ssw.ssw_fit_table)."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -1,7 +1,7 @@
 """Re-simulate one chain's collisions with every contact recorded and track the SSW
 (chain.analysis.ssw_track). The field Fig. ssw_spacetime shows: ssw_fields.py."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.analysis.ssw_track import ssw_track_table

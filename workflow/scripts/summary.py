@@ -1,6 +1,6 @@
 """summary.json: the run's numbers beside the paper's (chain.report.numbers.summary)."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _inputs import selection
 from _logging import start

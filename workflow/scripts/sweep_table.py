@@ -1,7 +1,7 @@
 """Sweep table: C and SSW slope per model and chain, with each model's eta
 (chain.studies.sweep.sweep_table)."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

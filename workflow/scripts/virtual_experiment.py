@@ -1,7 +1,7 @@
 """The virtual experiment on one chain (chain.apparatus.virtual.run_virtual_experiment): a
 model of the apparatus writing a dataset in the measured-trace format (not data)."""
 
-import _hand_off  # noqa: F401 (first: the job may run in the job server)
+import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment

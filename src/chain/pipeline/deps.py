@@ -21,9 +21,9 @@ from chain.atomic import write_text_atomic
 #: The package whose files are followed.
 PACKAGE = "chain"
 
-#: Local helpers that say how a job runs, not what it computes (the job server's hand-
-#: off, chain.pipeline.job_server): not a code input, as Snakemake's own code is not.
-TRANSPORT = frozenset({"_hand_off"})
+#: Local helpers that say how a job runs, not what it computes (its store lookup,
+#: workflow/scripts/_job.py): not a code input, as Snakemake's own code is not.
+TRANSPORT = frozenset({"_job"})
 
 
 #: Import statements read in this process or an earlier one: {path: [mtime_ns, size,

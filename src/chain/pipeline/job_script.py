@@ -1,5 +1,6 @@
-"""A job's script run in this process: its exit status as Python's would be, and
-SIGINT and SIGTERM acting once (a job's own process, or the job server's child)."""
+"""A job's script run in this process (workflow/scripts/_job.py, after the store had
+no result for it): its exit status as Python's would be, and SIGINT and SIGTERM acting
+once."""
 
 from __future__ import annotations
 
@@ -42,8 +43,8 @@ def run_script(script: str) -> int:
 def stop_once(signum: int, frame) -> None:
     """Signal handler: end the job as SIGINT (KeyboardInterrupt) or SIGTERM (SystemExit
     with status 128 + signal) do, once; later SIGINT and SIGTERM are ignored, so that a
-    signal that arrives twice (sent to the process group, it reaches a job in the server
-    both directly and through its client) cannot cut the atomic writers' clean-up short.
+    signal that arrives twice (sent to a process group, and passed on by a parent)
+    cannot cut the atomic writers' clean-up short.
     The scripts' SIGTERM handler too (workflow/scripts/_logging.py).
 
     Parameters
@@ -59,8 +60,3 @@ def stop_once(signum: int, frame) -> None:
         raise KeyboardInterrupt
     raise SystemExit(SIGNAL_BASE + signum)
 
-
-def signals_once() -> None:
-    """SIGINT and SIGTERM act once, as :func:`stop_once` says."""
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, stop_once)
