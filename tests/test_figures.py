@@ -521,8 +521,6 @@ def test_save_figure_is_byte_reproducible(tmp_path, trace_inputs):
     assert mode & 0o044, "figures must be readable by others (not left at mkstemp's 0600)"
 
 
-
-
 @pytest.mark.parametrize("figure", ["fig3", "fig4", "fig5", "parity"])
 def test_pdf_and_png_drawn_at_once_have_the_bytes_of_one_after_the_other(
     tmp_path, trace_inputs, figure

@@ -6,6 +6,7 @@ entry, ``--forceall``): tests/test_workflow.py."""
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import stat
@@ -279,6 +280,33 @@ def test_a_job_reuses_what_a_job_with_its_inputs_stored(tmp_path, monkeypatch):
     assert "simulate (N=25)" in lines[1] and "failed its check" in lines[1]
     assert "files/0" not in lines[1] or "SHA-256" in lines[1]
     assert not (tmp_path / "events").exists()
+
+
+def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(tmp_path, monkeypatch, capsys):
+    """A full or read-only disk under the store: the job's computed result stays in its
+    run folder (the job succeeds), the console names the file and says it is not
+    stored, and no staging folder is left. A store folder that cannot be made stops
+    the run before any job, naming the folder."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
+    monkeypatch.delenv(EVENTS_VARIABLE, raising=False)
+    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
+    full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(tmp_path / "store" / "tmp"))
+
+    def no_space(*args, **kwargs):
+        raise full
+
+    monkeypatch.setattr("chain.pipeline.store._copy_hashing", no_space)
+    job, calls = make_job(tmp_path), []
+    assert run_job(job, True, _folder(job), computing(job, calls)) == 0
+    assert Path(job.outputs[0]).read_text() == "N,F\n25,1.5\n"
+    err = capsys.readouterr().err
+    assert f"not stored (No space left on device: {tmp_path / 'store' / 'tmp'})" in err
+    assert not list((tmp_path / "store").glob("??/*"))
+    assert not list((tmp_path / "store" / "tmp").iterdir())
+    (tmp_path / "file").write_text("")
+    with pytest.raises(StoreError, match=f"{tmp_path / 'file' / 'store'}: Not a directory"):
+        Store.open({STORE_VARIABLE: str(tmp_path / "file" / "store")})
 
 
 def test_the_forecast_follows_stored_results_down_the_chain(tmp_path, monkeypatch):

@@ -28,7 +28,7 @@ PLAN = RunPlan(config)
 
 # The result store (chain.pipeline.reuse): no one else may write it, checked here.
 try:
-    STORE = Store.open(os.environ)
+    STORE = Store.open(os.environ) if config["reuse"] else None
 except StoreError as error:
     raise WorkflowError(str(error)) from None
 # Two defects of Snakemake's scheduler, patched (chain.pipeline.snakemake_patches); the

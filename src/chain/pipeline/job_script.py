@@ -59,4 +59,3 @@ def stop_once(signum: int, frame) -> None:
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise SystemExit(SIGNAL_BASE + signum)
-

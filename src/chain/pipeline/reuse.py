@@ -163,7 +163,12 @@ def _store(store: Store, key: str, job: Job, run_folder: str, recompute: bool) -
         "run": Path(run_folder).name,
         "stored": time.strftime("%Y-%m-%dT%H:%M:%S"),
     }
-    store.put(key, job.outputs, about, replace=recompute)
+    try:
+        store.put(key, job.outputs, about, replace=recompute)
+    except OSError as error:  # a full or read-only disk: the job's result stands
+        where = error.filename or store.root
+        _event(job, "computed", f"not stored ({error.strerror}: {where}); kept in the run")
+        return
     after = json.loads((entry / "manifest.json").read_text())["outputs"]
     if before is not None and before != after:
         _event(job, "differs", "recomputed bytes differ from the stored ones (replaced)")

@@ -117,7 +117,13 @@ class Store:
         except KeyError:
             raise StoreError(f"{GROUP_VARIABLE}={group}: no such group") from None
         store = cls(root, gid)
-        root.mkdir(parents=True, exist_ok=True, mode=store.folder_mode)
+        try:
+            root.mkdir(parents=True, exist_ok=True, mode=store.folder_mode)
+        except OSError as error:
+            raise StoreError(
+                f"result store {root}: {error.strerror}; set {STORE_VARIABLE} to a folder "
+                "you can write, or run with --config reuse=False"
+            ) from None
         store._check_root()
         return store
 
