@@ -23,7 +23,10 @@ def _number(value) -> str:
         return "n/a"
     if abs(value) >= 1000:
         return f"{value:,.0f}"
-    return f"{value:.3g}"
+    text = f"{value:.3g}"
+    if value != round(value) and float(text) == round(value):  # 1.002 is not "1"
+        text = f"{value:.2f}"
+    return text
 
 
 def _cell(text) -> str:
