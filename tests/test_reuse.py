@@ -9,6 +9,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import shutil
 import stat
 import subprocess
 from pathlib import Path
@@ -20,6 +21,7 @@ from chain.pipeline.reuse import (
     RECOMPUTE_VARIABLE,
     Job,
     forecast,
+    older_results,
     report_events,
     run_job,
     software_versions,
@@ -307,6 +309,24 @@ def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(tmp_path, m
     (tmp_path / "file").write_text("")
     with pytest.raises(StoreError, match=f"{tmp_path / 'file' / 'store'}: Not a directory"):
         Store.open({STORE_VARIABLE: str(tmp_path / "file" / "store")})
+
+
+def test_what_an_older_version_left_is_named_and_never_taken(tmp_path):
+    """Links into an older version's world-writable cache stop the run, naming one and
+    the command that removes them; the cache itself gets a line; then the run goes on."""
+    cache = tmp_path / "results" / ".cache" / "ab"
+    cache.mkdir(parents=True)
+    (cache / "table.csv").write_text("x\n1\n")
+    run = tmp_path / "results" / "paper"
+    (run / "tables").mkdir(parents=True)
+    (run / "tables" / "pulses.csv").symlink_to(cache / "table.csv")
+    with pytest.raises(StoreError, match=r"1 links left by an older version .*pulses.csv"):
+        older_results(str(run))
+    (run / "tables" / "pulses.csv").unlink()
+    (line,) = older_results(str(run))
+    assert f"{tmp_path / 'results' / '.cache'} is an older version's result cache" in line
+    shutil.rmtree(tmp_path / "results" / ".cache")
+    assert older_results(str(run)) == []
 
 
 def test_the_forecast_follows_stored_results_down_the_chain(tmp_path, monkeypatch):

@@ -19,7 +19,7 @@ from chain.pipeline.datasets import (
 from chain.pipeline.deps import remember_imports, save_imports, script_sources
 from chain.pipeline.plan import RunPlan
 from chain.pipeline.provenance import run_provenance
-from chain.pipeline.reuse import Job, run_ended, run_started
+from chain.pipeline.reuse import Job, older_results, run_ended, run_started
 from chain.pipeline.snakemake_patches import patch_snakemake
 from chain.pipeline.store import Store, StoreError
 
@@ -29,6 +29,8 @@ PLAN = RunPlan(config)
 # The result store (chain.pipeline.reuse): no one else may write it, checked here.
 try:
     STORE = Store.open(os.environ) if config["reuse"] else None
+    for line in older_results(PLAN.out) if workflow.is_main_process else []:
+        print(line)
 except StoreError as error:
     raise WorkflowError(str(error)) from None
 # Two defects of Snakemake's scheduler, patched (chain.pipeline.snakemake_patches); the

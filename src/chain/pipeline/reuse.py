@@ -31,6 +31,7 @@ from chain.pipeline.store import (
     CHECKSUMS,
     BadEntry,
     Store,
+    StoreError,
     file_digest,
     stored_digest,
     write_checksums,
@@ -241,6 +242,35 @@ def report_events(events: str | os.PathLike) -> list[str]:
     count = {kind: sum(r["event"] == kind for r in records) for kind in ("reused", "computed")}
     lines = [f"hertzchain store: {count['reused']} results reused, {count['computed']} computed"]
     return lines + [f"  {r['job']}: {r['detail']}" for r in records if r["detail"]]
+
+
+def older_results(run_folder: str) -> list[str]:
+    """What an older version left in ``results/``: its result cache
+    (``results/.cache``, writable by everyone, never checked), which nothing reads now,
+    and links into it in the run folder, which Snakemake would count as results.
+    Returns a console line for the cache; raises :class:`StoreError` (naming a link
+    and the command that removes them) when the run folder holds links.
+
+    Parameters
+    ----------
+    run_folder : str
+        ``results/<run_name>``.
+    """
+    old_cache = Path(run_folder).parent / ".cache"
+    links = [p for p in Path(run_folder).rglob("*") if p.is_symlink()]
+    if links:
+        raise StoreError(
+            f"{run_folder} holds {len(links)} links left by an older version (e.g. "
+            f"{links[0]} -> {os.readlink(links[0])}), unchecked results: remove them "
+            f"(`find {run_folder} -type l -delete`) and run again; their jobs then "
+            "compute or take a checked stored result"
+        )
+    if not old_cache.is_dir():
+        return []
+    return [
+        f"hertzchain: {old_cache} is an older version's result cache (writable by "
+        f"everyone, never checked); nothing reads it now: `rm -rf {old_cache}`"
+    ]
 
 
 def run_started(jobs: list[Job], store: Store, run_folder: str, reuse: bool, forced: bool):
