@@ -311,6 +311,37 @@ def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(tmp_path, m
         Store.open({STORE_VARIABLE: str(tmp_path / "file" / "store")})
 
 
+def test_a_read_only_store_hands_on_nothing_damaged_and_loses_nothing(
+    tmp_path, monkeypatch, capsys
+):
+    """A store on a read-only disk (renames in it fail; root ignores modes, so the
+    failure is injected): a damaged entry it cannot discard is still never handed on,
+    the job computes, and its result stays in the run folder, named as not stored."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
+    monkeypatch.delenv(EVENTS_VARIABLE, raising=False)
+    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
+    calls: list[str] = []
+    first, second = make_job(tmp_path), make_job(tmp_path, run="second")
+    run_job(first, True, _folder(first), computing(first, calls))
+    (entry,) = (tmp_path / "store").glob("??/*")
+    os.chmod(entry / "files" / "0", 0o600)
+    (entry / "files" / "0").write_text("N,F\n25,9.9\n")
+    rename = os.rename
+
+    def read_only(source, target):
+        if str(tmp_path / "store") in str(target):
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(source))
+        rename(source, target)
+
+    monkeypatch.setattr("chain.pipeline.store.os.rename", read_only)
+    assert run_job(second, True, _folder(second), computing(second, calls)) == 0
+    assert calls == ["simulate"] * 2
+    assert Path(second.outputs[0]).read_text() == "N,F\n25,1.5\n"
+    err = capsys.readouterr().err
+    assert "failed its check" in err and "not stored (Read-only file system" in err
+
+
 def test_what_an_older_version_left_is_named_and_never_taken(tmp_path):
     """Links into an older version's world-writable cache stop the run, naming one and
     the command that removes them; the cache itself gets a line; then the run goes on."""

@@ -15,6 +15,7 @@ is found, the entry discarded and the job computed anew (:class:`BadEntry`).
 
 from __future__ import annotations
 
+import errno
 import grp
 import hashlib
 import json
@@ -235,8 +236,8 @@ class Store:
                 self.discard(key)
             os.rename(staging, final)
             return True
-        except OSError:
-            if self.entry(key).is_dir():
+        except OSError as error:
+            if error.errno in (errno.EEXIST, errno.ENOTEMPTY) and self.entry(key).is_dir():
                 return False  # stored meanwhile by another run: one entry is kept
             raise
         finally:
@@ -258,10 +259,10 @@ class Store:
         """Remove ``key``'s entry (renamed away first: a reader sees it whole or not)."""
         entry = self.entry(key)
         gone = self.root / "tmp" / f"discarded.{key}.{os.urandom(4).hex()}"
-        gone.parent.mkdir(exist_ok=True, mode=self.folder_mode)
         try:
+            gone.parent.mkdir(exist_ok=True, mode=self.folder_mode)
             os.rename(entry, gone)
-        except FileNotFoundError:
+        except OSError:  # gone already, or a read-only store: never handed on anyway
             return
         _remove(gone)
 
