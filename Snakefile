@@ -5,12 +5,12 @@
 
 from snakemake.utils import min_version, validate
 
-from chain.pipeline.config_files import check_config_files
-from chain.pipeline.run_end import freeze_at_exit
+from chain.pipeline.config.files import check_config_files
+from chain.pipeline.run.run_end import freeze_at_exit
 
 min_version("9.0")
 # Snakemake's ~1500 modules cost 0.3-0.45 s of garbage collection at the exit of every
-# command, a dry run's or a failed check's too (chain.pipeline.run_end).
+# command, a dry run's or a failed check's too (chain.pipeline.run.run_end).
 freeze_at_exit()
 # Snakemake names neither the file nor the line of a YAML mistake, and keeps the last of
 # two equal keys: check the main config before it is read, the overlays (read already)

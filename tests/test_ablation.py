@@ -1,6 +1,6 @@
 """Ablation of the virtual experiment: the switches that turn an apparatus ingredient
 into the paper's simulation, and the config-driven variants
-(chain.pipeline.ablation_config, chain.studies.ablation_table)."""
+(chain.pipeline.config.ablation, chain.studies.ablation_table)."""
 
 import copy
 import dataclasses
@@ -17,13 +17,13 @@ from chain.apparatus.virtual import VirtualExperiment, plan_shots, simulate_virt
 from chain.errors import ConfigError, ParameterError
 from chain.physics.builders import uniform_chain
 from chain.physics.simulation import simulate
-from chain.pipeline.ablation_config import (
+from chain.pipeline.config.ablation import (
     ablation_variants,
     check_ablation,
     variant_settings,
     variant_tolerance,
 )
-from chain.pipeline.virtual_config import virtual_experiment_settings
+from chain.pipeline.config.virtual import virtual_experiment_settings
 from chain.studies.ablation_table import ablation_table
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -24,7 +24,7 @@ import pypdf
 import pytest
 from matplotlib.figure import Figure
 
-from chain.pipeline.headline import headline_numbers
+from chain.pipeline.provenance.headline import headline_numbers
 from chain.report.numbers.claim_rows import NOT_COMPUTED, TOLERANCES
 from chain.report.numbers.claims import claims, with_claims
 from chain.report.numbers.summary import decisions

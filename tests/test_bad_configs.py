@@ -2,7 +2,7 @@
 job, with a message naming the key, and nothing written under results/.
 
 The checks are run as the Snakefile runs them (config files as text, the JSON schema,
-chain.pipeline.config.check_config, experiment_parts, the dataset check), in a
+chain.pipeline.config.check.check_config, experiment_parts, the dataset check), in a
 temporary working directory, so that "nothing written" is observable; a few cases go
 through Snakemake itself (test_bad_input_workflow.py).
 """
@@ -19,9 +19,9 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
 from chain.errors import ConfigError
-from chain.pipeline.config import check_config, check_finite
-from chain.pipeline.config_files import check_config_file
-from chain.pipeline.datasets import check_experiment_datasets, experiment_parts
+from chain.pipeline.config.check import check_config, check_finite
+from chain.pipeline.config.files import check_config_file
+from chain.pipeline.plan.datasets import check_experiment_datasets, experiment_parts
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -189,7 +189,7 @@ def test_shipped_config_files_pass():
 
 
 def test_command_line_names_file_and_line(tmp_path, capsys):
-    from chain.pipeline.config_files import main
+    from chain.pipeline.config.files import main
 
     bad = tmp_path / "bad.yaml"
     bad.write_text("launch:\n  v0_min_m_s: 0.1\n   count: [1\n")

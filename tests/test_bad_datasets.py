@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 from chain.apparatus.dataset_check import check_dataset
 from chain.apparatus.measured import MeasuredDataError, load_dataset
 from chain.errors import ConfigError
-from chain.pipeline.datasets import (
+from chain.pipeline.plan.datasets import (
     check_experiment_datasets,
     experiment_parts,
     skipped_shot_rows,

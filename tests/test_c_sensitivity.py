@@ -11,7 +11,7 @@ from snakemake.utils import validate
 
 from chain.apparatus.shots import simulate_shots
 from chain.physics.builders import uniform_chain
-from chain.pipeline.plan import launch_speeds
+from chain.pipeline.plan.run_plan import launch_speeds
 from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
 from chain.report.numbers.spread import ablation_summary, c_spread_summary
 from chain.report.text.markdown_studies import spread_markdown_rows

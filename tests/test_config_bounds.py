@@ -1,6 +1,6 @@
 """Config bounds (issue 32, item 3): every value outside a key's range stops the run
 before any job, naming the key; the values at the bounds pass; docs/config_bounds.md is
-the table the schema and chain.pipeline.config_bounds_table.RULES give.
+the table the schema and chain.pipeline.config.bounds_table.RULES give.
 
 Each case changes the tiny config (tests/configs/tiny.yaml on config.yaml) and runs the
 checks the Snakefile runs (schema, then check_config); one case goes through Snakemake.
@@ -18,9 +18,9 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
-from chain.pipeline.config import ConfigError, check_config
-from chain.pipeline.config_bounds import variant_config
-from chain.pipeline.config_bounds_table import CHOICE, RULES, bounds_table, table_rows
+from chain.pipeline.config.check import ConfigError, check_config
+from chain.pipeline.config.bounds import variant_config
+from chain.pipeline.config.bounds_table import CHOICE, RULES, bounds_table, table_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -246,7 +246,7 @@ def test_table_is_generated_from_schema_and_rules():
     schema = yaml.safe_load(SCHEMA.read_text())
     table = bounds_table(schema)
     assert (ROOT / "docs" / "config_bounds.md").read_text() == table, (
-        "regenerate: python -m chain.pipeline.config_bounds "
+        "regenerate: python -m chain.pipeline.config.bounds "
         "workflow/schemas/config.schema.yaml > docs/config_bounds.md"
     )
     keys = {line.split("`")[1] for line in table.splitlines() if line.startswith("| `")}

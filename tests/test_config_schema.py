@@ -1,5 +1,5 @@
 """The pipeline's config: the JSON schema (workflow/schemas/config.schema.yaml), the
-semantic checks of chain.pipeline.config, and the shipped configs (config.yaml, whatif/).
+semantic checks of chain.pipeline.config.check, and the shipped configs (config.yaml, whatif/).
 
 A bad config must stop before any job runs, with a message naming the key.
 """
@@ -19,8 +19,8 @@ from snakemake.utils import update_config, validate
 from chain.analysis.pulses import ESTIMATORS
 from chain.errors import ConfigError
 from chain.physics.materials import MATERIALS
-from chain.pipeline.config import check_config, key_name
-from chain.pipeline.datasets import experiment_parts
+from chain.pipeline.config.check import check_config, key_name
+from chain.pipeline.plan.datasets import experiment_parts
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -123,7 +123,7 @@ def test_virtual_settings_map_onto_the_virtual_experiment(paper):
     from dataclasses import fields
 
     from chain.apparatus.virtual import VirtualExperiment
-    from chain.pipeline.virtual_config import VIRTUAL_KEYS, virtual_experiment
+    from chain.pipeline.config.virtual import VIRTUAL_KEYS, virtual_experiment
 
     # The config's keys are the fields' names: experiment.virtual passes on as it is.
     schema = load(SCHEMA)["properties"]["experiment"]["properties"]["virtual"]["properties"]
@@ -140,7 +140,7 @@ def test_virtual_settings_map_onto_the_virtual_experiment(paper):
 
 
 def test_experiment_parts_and_labels(paper):
-    from chain.pipeline.datasets import experiment_label
+    from chain.pipeline.plan.datasets import experiment_label
 
     config = validated(paper)
     virtual = experiment_parts(config)
@@ -171,7 +171,7 @@ def test_duration_check_has_margin_on_the_shipped_configs(paper):
     """The estimate behind the duration check, against the paper run: the slowest
     simulated wave (0.021 m/s) and striker wave (0.4 m/s) of the N = 26 chain."""
     from chain.physics.theory import pulse_passing_time
-    from chain.pipeline.config import DURATION_MARGIN
+    from chain.pipeline.config.check import DURATION_MARGIN
 
     slow = pulse_passing_time("steel_100C6", 0.013, 26, [10, 17], 0.021)
     # The simulation measures F_m = 10.0 N; the estimate is a little lower (slower).
@@ -215,7 +215,7 @@ def test_every_key_is_described_and_closed():
 
 def config_error(config: dict) -> str:
     """The message that stops ``config``: the schema's (snakemake.utils.validate), else
-    chain.pipeline.config' (check_config, then experiment_parts, as the Snakefile runs
+    chain.pipeline.config.check' (check_config, then experiment_parts, as the Snakefile runs
     them); fails the test if the config passes."""
     config = copy.deepcopy(config)
     try:
@@ -228,7 +228,7 @@ def config_error(config: dict) -> str:
 
 
 def key(name: str) -> str:
-    """How chain.pipeline.config names a key."""
+    """How chain.pipeline.config.check names a key."""
     return f"config key '{name}': "
 
 
@@ -356,7 +356,7 @@ BAD_CONFIGS = {
         on("figures", "parity_ssw_vs_N"),
         "is not of type 'boolean'",
     ),
-    # -- relations between keys (chain.pipeline.config.check_config) --
+    # -- relations between keys (chain.pipeline.config.check.check_config) --
     "sensor inside 1..N": (
         setter("chains", 0, "sensors", value=[9, 30]),
         key("chains[0].sensors[1]"),

@@ -1,4 +1,4 @@
-"""The code inputs of a rule (chain.pipeline.deps): the package files its script runs,
+"""The code inputs of a rule (chain.pipeline.plan.code): the package files its script runs,
 and the store that spares the next command parsing them again."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from chain.pipeline import deps
+from chain.pipeline.plan import code as deps
 
 
 @pytest.fixture

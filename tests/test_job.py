@@ -57,7 +57,7 @@ import signal
 import time
 
 from chain.atomic import atomic_output
-from chain.pipeline.job_script import stop_once
+from chain.pipeline.run.job_script import stop_once
 
 signal.signal(signal.SIGTERM, stop_once)  # as the scripts' _logging.start does
 with atomic_output("out/result.txt") as temporary:

@@ -127,8 +127,8 @@ def test_the_check_catches_an_uphill_import(tmp_path):
     assert allowed("chain.report.figures.fig4_delay_vs_force", "chain.analysis.rows")
     assert not allowed("chain.report.figures.fig4_delay_vs_force", "chain.physics.integrator")
     assert not allowed("chain.analysis.ssw", "chain.apparatus.virtual")
-    assert allowed("chain.pipeline.config", "chain.studies.ablation")
-    assert not allowed("chain.studies.ablation", "chain.pipeline.virtual_config")
+    assert allowed("chain.pipeline.config.check", "chain.studies.ablation")
+    assert not allowed("chain.studies.ablation", "chain.pipeline.config.virtual")
     assert not allowed("chain.studies.sweep", "chain.report.fig_c_vs_N")
 
 
@@ -229,7 +229,7 @@ def test_report_parts_import_downhill(module):
 
 
 def test_report_package_inits_import_nothing():
-    """A figure's rule depends on the code its script imports (chain.pipeline.deps),
+    """A figure's rule depends on the code its script imports (chain.pipeline.plan.code),
     with the __init__ files on the way: they must not pull in the whole report."""
     for name in (
         "chain.report",

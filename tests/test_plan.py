@@ -1,4 +1,4 @@
-"""The run plan (chain.pipeline.plan.RunPlan): each fact of a run derived once from the
+"""The run plan (chain.pipeline.plan.run_plan.RunPlan): each fact of a run derived once from the
 checked config, and a simulate job's inputs as a cache key (issue 31, issue 33)."""
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import pytest
 import yaml
 from snakemake.utils import validate
 
-from chain.pipeline.config import check_config
-from chain.pipeline.jobs import JOB_KEYS, chain_of
-from chain.pipeline.plan import RunPlan
+from chain.pipeline.config.check import check_config
+from chain.pipeline.plan.jobs import JOB_KEYS, chain_of
+from chain.pipeline.plan.run_plan import RunPlan
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"

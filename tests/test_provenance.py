@@ -1,4 +1,4 @@
-"""chain.pipeline.provenance: what summary.json and the article state about the run that
+"""chain.pipeline.provenance.record: what summary.json and the article state about the run that
 produced them, and how its packages compare with the lock.
 
 Every value is a function of the checkout, the configuration and the installed packages,
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from chain.pipeline.provenance import (
+from chain.pipeline.provenance.record import (
     NOT_GIT,
     compare_with_lock,
     config_hash,

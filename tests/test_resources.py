@@ -1,4 +1,4 @@
-"""What a simulate job asks a batch scheduler for (chain.pipeline.resources): the memory
+"""What a simulate job asks a batch scheduler for (chain.pipeline.plan.resources): the memory
 request covers the measured peak of a real simulation, and grows with N and duration."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 from chain.errors import ParameterError
 from chain.physics.builders import uniform_chain
 from chain.physics.materials import get_material
-from chain.pipeline.resources import (
+from chain.pipeline.plan.resources import (
     BASE_MB,
     BYTES_PER_BEAD_SAMPLE,
     MAX_THREADS,

@@ -1,5 +1,5 @@
-"""The result store (chain.pipeline.store) and the jobs' reuse of it
-(chain.pipeline.reuse): what a job stored comes back byte for byte or not at all, the
+"""The result store (chain.pipeline.run.store) and the jobs' reuse of it
+(chain.pipeline.run.reuse): what a job stored comes back byte for byte or not at all, the
 store is the user's alone, and a job's key changes with everything that makes its
 bytes. The store at work in the workflow (a renamed run, an analysis what-if, a damaged
 entry, ``--forceall``): tests/test_workflow.py."""
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from chain.pipeline.reuse import (
+from chain.pipeline.run.reuse import (
     EVENTS_VARIABLE,
     RECOMPUTE_VARIABLE,
     Job,
@@ -26,7 +26,7 @@ from chain.pipeline.reuse import (
     run_job,
     software_versions,
 )
-from chain.pipeline.store import (
+from chain.pipeline.run.store import (
     CHECKSUMS,
     STORE_VARIABLE,
     BadEntry,
@@ -298,7 +298,7 @@ def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(tmp_path, m
     def no_space(*args, **kwargs):
         raise full
 
-    monkeypatch.setattr("chain.pipeline.store._copy_hashing", no_space)
+    monkeypatch.setattr("chain.pipeline.run.store._copy_hashing", no_space)
     job, calls = make_job(tmp_path), []
     assert run_job(job, True, _folder(job), computing(job, calls)) == 0
     assert Path(job.outputs[0]).read_text() == "N,F\n25,1.5\n"
@@ -334,7 +334,7 @@ def test_a_read_only_store_hands_on_nothing_damaged_and_loses_nothing(
             raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(source))
         rename(source, target)
 
-    monkeypatch.setattr("chain.pipeline.store.os.rename", read_only)
+    monkeypatch.setattr("chain.pipeline.run.store.os.rename", read_only)
     assert run_job(second, True, _folder(second), computing(second, calls)) == 0
     assert calls == ["simulate"] * 2
     assert Path(second.outputs[0]).read_text() == "N,F\n25,1.5\n"

@@ -1,4 +1,4 @@
-"""chain.pipeline.run_end: a process frozen at exit skips the shutdown's collections and
+"""chain.pipeline.run.run_end: a process frozen at exit skips the shutdown's collections and
 keeps everything else its exit does."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ def test_a_process_frozen_at_exit_keeps_its_exit_handlers_status_and_open_files(
     code = textwrap.dedent(
         f"""
         import atexit, gc, sys
-        from chain.pipeline.run_end import freeze_at_exit
+        from chain.pipeline.run.run_end import freeze_at_exit
 
         atexit.register(lambda: print("frozen", gc.get_freeze_count() > 0, flush=True))
         freeze_at_exit()

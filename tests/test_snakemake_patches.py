@@ -1,4 +1,4 @@
-"""chain.pipeline.snakemake_patches: Snakemake's scheduler keeps one pending wake-up,
+"""chain.pipeline.run.snakemake_patches: Snakemake's scheduler keeps one pending wake-up,
 not one more per pass, and a SIGTERM that finds its main thread holding the scheduler's
 lock stops the run instead of hanging it; both apply to the locked Snakemake, and a
 run on another release says so. No clock: a pending timer here would fire in an hour,
@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from snakemake.scheduling.job_scheduler import JobScheduler
 
-from chain.pipeline.snakemake_patches import (
+from chain.pipeline.run.snakemake_patches import (
     SIGTERM_METHOD,
     WAKEUP_METHOD,
     WRITTEN_FOR,

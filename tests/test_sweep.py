@@ -130,7 +130,7 @@ def test_slurm_profile_gives_jobs_their_resources():
     pytest.importorskip("snakemake_executor_plugin_slurm")
     out = dry_run("--workflow-profile", "profiles/slurm", "--cores", "8")
     simulate = out[out.index("rule simulate:") :].split("\n\n")[0]
-    # The paper's chains are small: one thread each (chain.pipeline.resources).
+    # The paper's chains are small: one thread each (chain.pipeline.plan.resources).
     assert re.search(r"mem_mb=\d+00,.*runtime=\d+.*cpus_per_task=1", simulate), simulate
     fig1 = out[out.index("rule fig1_setup:") :].split("\n\n")[0]
     assert re.search(r"mem_mb=1000,.*runtime=15.*cpus_per_task=1", fig1), fig1

@@ -356,7 +356,7 @@ def test_a_copied_checkout_has_nothing_to_do(tiny, tmp_path):
     assert planned_jobs(copy, env) == {}
 
 
-# ---- reuse across runs (issue 52; chain.pipeline.reuse, chain.pipeline.store) ---------
+# ---- reuse across runs (issue 52; chain.pipeline.run.reuse, chain.pipeline.run.store) ---------
 
 #: What a run states about itself (its name, provenance): made anew by every run.
 PER_RUN_LOGS = {"summary.log", "summary_md.log", "article.log"}

@@ -237,7 +237,7 @@ def _add_check_config(commands) -> None:
 
 
 def _check_config(args: argparse.Namespace) -> int:
-    from chain.pipeline.config_files import main as check_config_files
+    from chain.pipeline.config.files import main as check_config_files
 
     return check_config_files(args.configfiles)
 
@@ -245,8 +245,8 @@ def _check_config(args: argparse.Namespace) -> int:
 def _check(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from chain.pipeline import headline
-    from chain.pipeline.provenance import lock_warnings
+    from chain.pipeline.provenance import headline
+    from chain.pipeline.provenance.record import lock_warnings
 
     folder = Path(args.run_folder)
     summary_path = folder / "summary.json"

@@ -1,7 +1,7 @@
 # Shared definitions: the config check, the run plan, output paths, the library files
 # each stage depends on, and the input functions of more than one rule file. Every fact
 # of the config (speeds, chains, jobs, studies, targets) comes from the plan
-# (chain.pipeline.plan.RunPlan); each stage's helpers sit in its own rule file.
+# (chain.pipeline.plan.run_plan.RunPlan); each stage's helpers sit in its own rule file.
 
 import importlib.util
 import os
@@ -11,29 +11,29 @@ from snakemake import __version__ as SNAKEMAKE_VERSION
 from snakemake.exceptions import WorkflowError
 from snakemake.scheduling.job_scheduler import JobScheduler
 
-from chain.pipeline.config import check_config
-from chain.pipeline.datasets import (
+from chain.pipeline.config.check import check_config
+from chain.pipeline.plan.datasets import (
     DEFAULT_CACHE as DATASET_CHECK_CACHE,
     check_experiment_datasets,
 )
-from chain.pipeline.deps import remember_imports, save_imports, script_sources
-from chain.pipeline.plan import RunPlan
-from chain.pipeline.provenance import run_provenance
-from chain.pipeline.reuse import Job, older_results, run_ended, run_started
-from chain.pipeline.snakemake_patches import patch_snakemake
-from chain.pipeline.store import Store, StoreError
+from chain.pipeline.plan.code import remember_imports, save_imports, script_sources
+from chain.pipeline.plan.run_plan import RunPlan
+from chain.pipeline.provenance.record import run_provenance
+from chain.pipeline.run.reuse import Job, older_results, run_ended, run_started
+from chain.pipeline.run.snakemake_patches import patch_snakemake
+from chain.pipeline.run.store import Store, StoreError
 
 check_config(config)
 PLAN = RunPlan(config)
 
-# The result store (chain.pipeline.reuse): no one else may write it, checked here.
+# The result store (chain.pipeline.run.reuse): no one else may write it, checked here.
 try:
     STORE = Store.open(os.environ) if config["reuse"] else None
     for line in older_results(PLAN.out) if workflow.is_main_process else []:
         print(line)
 except StoreError as error:
     raise WorkflowError(str(error)) from None
-# Two defects of Snakemake's scheduler, patched (chain.pipeline.snakemake_patches); the
+# Two defects of Snakemake's scheduler, patched (chain.pipeline.run.snakemake_patches); the
 # console says so when this Snakemake is not the release they were written for.
 for line in patch_snakemake(JobScheduler, SNAKEMAKE_VERSION):
     if workflow.is_main_process:
@@ -57,7 +57,7 @@ ENV = "../envs/hertzchain.yaml"
 BENCH = f"{OUT}/benchmarks"
 
 # The code each job runs is an input of its rule: its script, the script's local
-# helpers and every chain module it imports (chain.pipeline.deps), so editing the
+# helpers and every chain module it imports (chain.pipeline.plan.code), so editing the
 # physics reruns the simulations, and one figure's module redraws that figure only.
 # Paths relative to the working directory: a moved or copied checkout has nothing to
 # do. PACKAGE_DIR is the package the jobs import (src/chain, or PYTHONPATH's copy). The

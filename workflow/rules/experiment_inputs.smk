@@ -1,7 +1,7 @@
 # Input functions of the experiment's rules (experiment.smk) and of Fig. 2, from the
 # plan's experiment parts.
 
-from chain.pipeline.datasets import bad_channel_policy
+from chain.pipeline.plan.datasets import bad_channel_policy
 
 
 def raw_dataset(n):

@@ -11,7 +11,7 @@ def all_trace_files(wildcards=None):
 
 # What a batch scheduler is asked for (issue 16; a plain local run ignores it): threads,
 # one per ~10 s of estimated integration (the paper's jobs take 1); memory ~ N x speeds
-# x duration, MB; runtime, minutes (chain.pipeline.resources). ssw_track asks the same.
+# x duration, MB; runtime, minutes (chain.pipeline.plan.resources). ssw_track asks the same.
 def simulate_threads(wildcards):
     return PLAN.simulation_threads(wildcards.model, int(wildcards.N))
 

@@ -1,16 +1,16 @@
 """First import of every script: the job takes its result from the store if one is
 stored, else runs its script here and stores what it computed; then the process exits
-with the job's status (chain.pipeline.reuse.run_job). Not a code input of the rules
-(chain.pipeline.deps.TRANSPORT): it says how a job runs, not what it computes.
+with the job's status (chain.pipeline.run.reuse.run_job). Not a code input of the rules
+(chain.pipeline.plan.code.TRANSPORT): it says how a job runs, not what it computes.
 
 The process skips the final garbage collections when it exits
-(chain.pipeline.run_end.freeze_at_exit: 0.4-0.5 s less for a job's libraries).
+(chain.pipeline.run.run_end.freeze_at_exit: 0.4-0.5 s less for a job's libraries).
 """
 
 import __main__
-from chain.pipeline.job_script import run_script
-from chain.pipeline.reuse import Job, run_job
-from chain.pipeline.run_end import freeze_at_exit
+from chain.pipeline.run.job_script import run_script
+from chain.pipeline.run.reuse import Job, run_job
+from chain.pipeline.run.run_end import freeze_at_exit
 
 # Run again by run_script, the script finds this module imported: the job runs once.
 if hasattr(__main__, "snakemake"):

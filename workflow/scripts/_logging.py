@@ -4,7 +4,7 @@ import logging
 import signal
 import sys
 
-from chain.pipeline.job_script import stop_once
+from chain.pipeline.run.job_script import stop_once
 
 
 def start(snakemake) -> logging.Logger:

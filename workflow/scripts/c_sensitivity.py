@@ -7,7 +7,7 @@ from _logging import start
 
 from chain.apparatus.shots import simulate_shots
 from chain.atomic import write_csv_atomic
-from chain.pipeline.jobs import chain_of, simulation_kwargs
+from chain.pipeline.plan.jobs import chain_of, simulation_kwargs
 from chain.studies.c_sensitivity import c_sensitivity_every_estimator
 
 log = start(snakemake)

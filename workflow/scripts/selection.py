@@ -8,7 +8,7 @@ from _logging import start
 from chain.analysis.selection import select_shots
 from chain.apparatus.dataset_check import check_dataset
 from chain.atomic import write_csv_atomic
-from chain.pipeline.datasets import skipped_shot_rows
+from chain.pipeline.plan.datasets import skipped_shot_rows
 
 log = start(snakemake)
 p = snakemake.params

@@ -5,7 +5,7 @@ from _logging import start
 
 from chain.apparatus.shots import simulate_shots
 from chain.atomic import write_csv_atomic
-from chain.pipeline.jobs import chain_of, simulation_kwargs
+from chain.pipeline.plan.jobs import chain_of, simulation_kwargs
 from chain.traces import write_traces
 
 log = start(snakemake)

@@ -8,7 +8,7 @@ from chain.analysis.ssw_track import ssw_track_table
 from chain.apparatus.shots import shot_time_step
 from chain.atomic import write_csv_atomic
 from chain.physics.simulation import simulate
-from chain.pipeline.jobs import chain_of
+from chain.pipeline.plan.jobs import chain_of
 
 log = start(snakemake)
 job = snakemake.params.job

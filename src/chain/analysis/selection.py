@@ -28,7 +28,7 @@ from chain.errors import ParameterError
 DEFAULT_TOLERANCE = 0.05
 
 #: Start of the reason of a shot left out before the analysis for a dead or saturated
-#: channel (``experiment.bad_channels: skip``; chain.pipeline.datasets writes the rows).
+#: channel (``experiment.bad_channels: skip``; chain.pipeline.plan.datasets writes the rows).
 SKIPPED_REASON = "skipped (experiment.bad_channels: skip)"
 
 #: Columns of the selection table, in order.

@@ -1,6 +1,9 @@
 """The pipeline glue: the only code that knows ``results/``, and with the studies
-(:mod:`chain.studies`) the only code that knows the config's keys.
+(:mod:`chain.studies`) the only code that knows the config's keys. Four rooms, imports
+running one way (config <- plan <- run; provenance beside them):
 
-Cross-key config checks and experiment parts (:mod:`.config`, called by the
-Snakefile before any job) and the headline-number check (:mod:`.headline`).
+* :mod:`.config`: the checks of a config and their bounds;
+* :mod:`.plan`: what runs (the run plan, its jobs, their inputs and resources);
+* :mod:`.run`: what happens around Snakemake (the store, checksums, patches);
+* :mod:`.provenance`: what made a run, and the headline check.
 """

@@ -5,7 +5,7 @@ the paper's simulation plus apparatus ingredients: strikers instead of a launche
 bead, split sensor beads instead of a point readout, Kuwabara-Kono dissipation, noise
 and a digitiser, shot-to-shot speed mismatch and launch jitter, the 5 % acceptance
 protocol and its own range of amplitudes. A variant changes some of them
-(:mod:`chain.pipeline.ablation_config` maps the config's ``ablation.variants`` to the
+(:mod:`chain.pipeline.config.ablation` maps the config's ``ablation.variants`` to the
 settings of each chain). :func:`run_variant` runs the virtual experiment of every
 chain with those settings (the same seed as the run, so a variant with no overrides
 reproduces the run's experiment) and fits Delta = C F_m^(-1/6) and a free power law
@@ -48,7 +48,7 @@ def run_variant(
     ----------
     settings_per_chain : sequence of mapping
         VirtualExperiment fields, one mapping per chain
-        (:func:`chain.pipeline.ablation_config.variant_settings`).
+        (:func:`chain.pipeline.config.ablation.variant_settings`).
     tolerance : float or None
         Acceptance tolerance (relative amplitude mismatch); None keeps every shot.
     estimators : sequence of str
@@ -79,7 +79,7 @@ def run_variant_shots(
     to a temporary folder, then analysed by :func:`analyse_datasets`. With
     ``datasets`` (one folder per chain, written by the virtual experiment with exactly
     ``settings_per_chain`` and ``series``: the run's own, see
-    :meth:`chain.pipeline.plan.RunPlan.ablation_datasets`), those are analysed instead
+    :meth:`chain.pipeline.plan.run_plan.RunPlan.ablation_datasets`), those are analysed instead
     of simulating the same shots again.
 
     Returns

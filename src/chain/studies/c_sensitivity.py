@@ -67,7 +67,7 @@ def sensitivity_plan(config: Mapping, speeds_m_s: Sequence[float]) -> dict:
     config : mapping
         A schema-valid config.
     speeds_m_s : sequence of float
-        The run's launch speeds, m/s (:attr:`chain.pipeline.plan.RunPlan.speeds`).
+        The run's launch speeds, m/s (:attr:`chain.pipeline.plan.run_plan.RunPlan.speeds`).
 
     Returns
     -------

@@ -125,7 +125,7 @@ def candidate_variants(variants: Sequence[Mapping], full: bool) -> dict[str, tup
     Parameters
     ----------
     variants : sequence of mapping
-        :func:`chain.pipeline.ablation_config.ablation_variants`.
+        :func:`chain.pipeline.config.ablation.ablation_variants`.
     full : bool
         All candidates (target ``mechanisms``) rather than the default run's.
     """

@@ -356,7 +356,7 @@ def article_numbers(
         source), ``virtual`` (the virtual experiment's keys, SI), ``striker_radius_m``
         (m) and ``tolerance`` (acceptance, fraction).
     provenance : mapping, optional
-        :func:`chain.pipeline.provenance.run_provenance` of the run (commit, date,
+        :func:`chain.pipeline.provenance.record.run_provenance` of the run (commit, date,
         dirty, config_hash, versions); None prints "not recorded".
 
     Returns

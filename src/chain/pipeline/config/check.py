@@ -6,16 +6,16 @@ first (types, ranges, defaults; snakemake.utils.validate names the key as
 (:func:`check_finite`, one walk over the whole config: the schema's minimum/maximum let
 NaN through), then the relations between keys (sensor beads inside their chain, the
 Fig. 3 model among the models, a duration long enough for the waves, the virtual
-experiment's settings...), then :func:`chain.pipeline.datasets.experiment_parts`
+experiment's settings...), then :func:`chain.pipeline.plan.datasets.experiment_parts`
 reads the measured datasets' metadata and
-:func:`chain.pipeline.datasets.check_experiment_datasets` checks every shot file of
+:func:`chain.pipeline.plan.datasets.check_experiment_datasets` checks every shot file of
 them. Every message starts with the dotted name of the offending key, e.g. ``config
 key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config stops
 before any job runs and says where.
 
 :func:`check_config` takes a plain dict, reads no file and knows no Snakemake. What a
 checked config means for the run (speeds, chains, jobs, targets) is derived once, by
-:class:`chain.pipeline.plan.RunPlan`.
+:class:`chain.pipeline.plan.run_plan.RunPlan`.
 
 Duration check
 --------------
@@ -30,7 +30,7 @@ incident amplitude. That amplitude is estimated from the launch momentum:
   1030 N at V0 = 1 m/s; the ratio is the same for every material and radius by the
   scaling symmetry of the Hertz chain);
 * virtual experiment (strikers, or ``launch: bead``): checked in
-  :mod:`chain.pipeline.config_bounds_experiment`, from the launch's momentum.
+  :mod:`chain.pipeline.config.bounds_experiment`, from the launch's momentum.
 
 The duration must exceed :data:`DURATION_MARGIN` times that time. The paper run passes
 with 2.6 ms against 1.9 ms (simulation, 0.021 m/s, N = 26). The SSW search after the
@@ -50,8 +50,8 @@ from chain.physics.theory import (
     force_from_bead_velocity,
     pulse_passing_time,
 )
-from chain.pipeline.ablation_config import check_ablation
-from chain.pipeline.virtual_config import virtual_experiment
+from chain.pipeline.config.ablation import check_ablation
+from chain.pipeline.config.virtual import virtual_experiment
 
 #: The duration must be this many times the time the slowest pulse needs to pass the
 #: far sensor (see the module docstring).
@@ -320,7 +320,7 @@ def check_config(config: Mapping) -> None:
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
-    from chain.pipeline.config_bounds import check_bounds
+    from chain.pipeline.config.bounds import check_bounds
 
     check_ablation(config)
-    check_bounds(config, check_config)  # chain.pipeline.config_bounds: bounds needing 2 keys
+    check_bounds(config, check_config)  # chain.pipeline.config.bounds: bounds needing 2 keys

@@ -2,10 +2,10 @@
 collision point, record intervals against time steps and the narrowest pulse,
 durations against the slowest wave, LAMMPS file names (issue 32, item 3).
 
-Also the pulse estimates the bounds of :mod:`chain.pipeline.config_bounds_experiment`
+Also the pulse estimates the bounds of :mod:`chain.pipeline.config.bounds_experiment`
 share. A pulse of incident amplitude F_m has the half width tau = R sqrt(10) / v
 (Eq. 4, v of Eq. 5); F_m is estimated from the launch as in the duration check of
-:mod:`chain.pipeline.config`: V_m = LAUNCH_VELOCITY_RATIO x V0 for a launched bead.
+:mod:`chain.pipeline.config.check`: V_m = LAUNCH_VELOCITY_RATIO x V0 for a launched bead.
 
 This module reads no file and knows no Snakemake.
 """
@@ -32,7 +32,7 @@ from chain.studies.mechanism_settings import (
 )
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
-#: the slowest pulse. 1, not chain.pipeline.config.DURATION_MARGIN (1.2, which also
+#: the slowest pulse. 1, not chain.pipeline.config.check.DURATION_MARGIN (1.2, which also
 #: covers a striker's launch, estimated 12 % slow): a launched bead's estimate errs on
 #: the slow side already (ratio 0.45 against 0.47 measured), and whatif/brass.yaml's
 #: LAMMPS record (2.6 ms against 2.31 ms) passes its slowest wave.
@@ -138,7 +138,7 @@ def sensor_room(entry: Mapping) -> tuple[float, float]:
 
 
 def _check_sensors(config: Mapping) -> None:
-    # chain.pipeline.config checks 1 <= S1 < S2 <= N; the analysis needs more: at S1 the
+    # chain.pipeline.config.check checks 1 <= S1 < S2 <= N; the analysis needs more: at S1 the
     # incident LSTW, then the crossed RSTW (chain.analysis.pulse_rows), two pulses apart.
     for i, entry in enumerate(config["chains"]):
         middle = collision_point(entry["N"])
@@ -255,7 +255,7 @@ def check_run_bounds(config: Mapping) -> None:
     ----------
     config : mapping
         A schema-valid config (defaults filled in) that passed the checks of
-        :func:`chain.pipeline.config.check_config` before the bounds.
+        :func:`chain.pipeline.config.check.check_config` before the bounds.
 
     Raises
     ------

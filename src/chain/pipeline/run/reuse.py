@@ -1,5 +1,5 @@
 """Reuse across runs (issue 52): every job of the workflow takes its result from the
-store (:mod:`chain.pipeline.store`) when a job with the same inputs stored one, and
+store (:mod:`chain.pipeline.run.store`) when a job with the same inputs stored one, and
 stores what it computes.
 
 A job's key is the SHA-256 of everything that makes its bytes: its rule and
@@ -26,8 +26,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from chain.pipeline.provenance import PACKAGES, package_versions
-from chain.pipeline.store import (
+from chain.pipeline.provenance.record import PACKAGES, package_versions
+from chain.pipeline.run.store import (
     CHECKSUMS,
     BadEntry,
     Store,
@@ -82,7 +82,7 @@ class Job:
         Parameters
         ----------
         digests : mapping
-            Input path -> SHA-256 of its bytes (:func:`chain.pipeline.store.file_digest`).
+            Input path -> SHA-256 of its bytes (:func:`chain.pipeline.run.store.file_digest`).
         run_folder : str
             ``results/<run_name>``: outputs count relative to it, so that runs share.
         software : mapping
@@ -312,7 +312,7 @@ def run_started(jobs: list[Job], store: Store, run_folder: str, reuse: bool, for
 def run_ended(run_folder: str) -> None:
     """Say what the run's jobs did with the store (:func:`report_events`) and write the
     run folder's checksums of the files it holds now
-    (:func:`chain.pipeline.store.write_checksums`), whether the run succeeded or not.
+    (:func:`chain.pipeline.run.store.write_checksums`), whether the run succeeded or not.
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """The run plan: what a checked config means for the run, derived once.
 
 The Snakefile validates the config against its schema (which fills in every default)
-and checks it (:func:`chain.pipeline.config.check_config`); ``workflow/rules/common.smk``
+and checks it (:func:`chain.pipeline.config.check.check_config`); ``workflow/rules/common.smk``
 then makes ONE :class:`RunPlan` of it, and the rules ask the plan: the models and
 chains, the launch speeds (computed here only), the simulated durations, which models
 are conservative, the chain a job integrates and the job's inputs
@@ -29,11 +29,11 @@ from chain.apparatus.virtual_settings import VirtualExperiment
 from chain.labels import VIRTUAL_SERIES
 from chain.physics.lammps_library import lammps_available
 from chain.physics.model import ChainModel
-from chain.pipeline.ablation_config import ablation_variants, variant_settings, variant_tolerance
-from chain.pipeline.datasets import ExperimentPart, experiment_label, experiment_parts
-from chain.pipeline.jobs import chain_of
-from chain.pipeline.resources import JobNeeds, simulation_needs, simulation_threads
-from chain.pipeline.virtual_config import virtual_experiment_settings
+from chain.pipeline.config.ablation import ablation_variants, variant_settings, variant_tolerance
+from chain.pipeline.plan.datasets import ExperimentPart, experiment_label, experiment_parts
+from chain.pipeline.plan.jobs import chain_of
+from chain.pipeline.plan.resources import JobNeeds, simulation_needs, simulation_threads
+from chain.pipeline.config.virtual import virtual_experiment_settings
 from chain.studies.c_sensitivity import sensitivity_plan, shifted_pairs
 from chain.studies.mechanism_settings import (
     CANDIDATE_REFERENCE,
@@ -89,7 +89,7 @@ class RunPlan:
     ----------
     config : mapping
         The config after schema validation (defaults filled in) and
-        :func:`chain.pipeline.config.check_config`; copied, never changed.
+        :func:`chain.pipeline.config.check.check_config`; copied, never changed.
     root : str
         Folder that relative dataset paths start from (the working directory).
 
@@ -107,7 +107,7 @@ class RunPlan:
     traces_n : tuple of int
         Chains of Figs. 2 and 3 and the space-time figure (``figures.traces_N``, or all).
     ablation : dict
-        Variant name -> variant (:func:`chain.pipeline.ablation_config.ablation_variants`).
+        Variant name -> variant (:func:`chain.pipeline.config.ablation.ablation_variants`).
     """
 
     config: Mapping
@@ -175,7 +175,7 @@ class RunPlan:
         sensors: Sequence[int] | None = None,
     ) -> dict:
         """Every input that determines one simulate job's output (model, N), as a
-        JSON-serialisable dict (:data:`chain.pipeline.jobs.JOB_KEYS`; m, s, m/s): the
+        JSON-serialisable dict (:data:`chain.pipeline.plan.jobs.JOB_KEYS`; m, s, m/s): the
         chain, speeds, durations, step, record interval, readout. Analysis and figure
         keys are not in it; nor is a seed (the simulation draws nothing). A cache of
         results (issue 33) can hash it, with the job's code.
@@ -229,7 +229,7 @@ class RunPlan:
 
     def simulation_needs(self, model: str, n_beads: int, threads: int) -> JobNeeds:
         """Memory (MB) and run time (minutes) a simulate job asks a scheduler for
-        (:func:`chain.pipeline.resources.simulation_needs`)."""
+        (:func:`chain.pipeline.plan.resources.simulation_needs`)."""
         job = self.simulate_job(model, n_beads)
         return simulation_needs(
             chain_of(job),
@@ -242,7 +242,7 @@ class RunPlan:
         )
 
     def simulation_threads(self, model: str, n_beads: int) -> int:
-        """Cores a simulate job is worth (:func:`chain.pipeline.resources.simulation_threads`)."""
+        """Cores a simulate job is worth (:func:`chain.pipeline.plan.resources.simulation_threads`)."""
         job = self.simulate_job(model, n_beads)
         return simulation_threads(
             chain_of(job), len(self.speeds), max(self.speeds), job["duration_s"], job["time_step_s"]
@@ -252,7 +252,7 @@ class RunPlan:
 
     @cached_property
     def experiment(self) -> tuple[ExperimentPart, ...]:
-        """The experiment's chains (:func:`chain.pipeline.datasets.experiment_parts`;
+        """The experiment's chains (:func:`chain.pipeline.plan.datasets.experiment_parts`;
         reads the measured datasets' metadata when first asked)."""
         return tuple(experiment_parts(self.config, root=self.root))
 

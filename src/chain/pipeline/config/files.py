@@ -8,7 +8,7 @@ parses before the Snakefile runs) and names both.
 
 An overlay that is not valid YAML at all stops Snakemake before the Snakefile runs, with
 Snakemake's own message (``--verbose`` shows the parser's, with file and line);
-``python -m chain.pipeline.config_files whatif/x.yaml`` names them too.
+``python -m chain.pipeline.config.files whatif/x.yaml`` names them too.
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def check_config_files(paths: Iterable[str | os.PathLike]) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m chain.pipeline.config_files FILE...``: name the file and line of a YAML
+    """``python -m chain.pipeline.config.files FILE...``: name the file and line of a YAML
     mistake in config files (Snakemake parses ``--configfile`` overlays before the
     Snakefile runs, and its own message names neither)."""
     import sys

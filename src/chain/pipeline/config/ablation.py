@@ -5,7 +5,7 @@ A config's ``ablation.variants`` lists named variants, each a set of overrides o
 ``experiment.virtual`` keys (plus ``striker_radius_m`` of ``setup`` and ``tolerance`` of
 ``experiment``; ``tolerance: null`` switches the acceptance protocol off). The study
 that runs them is :mod:`chain.studies.ablation`; this module only maps config keys, so
-that the config checks (:mod:`chain.pipeline.config`) and the rules share it. It reads
+that the config checks (:mod:`chain.pipeline.config.check`) and the rules share it. It reads
 schema-valid configs (defaults filled in) and knows no Snakemake.
 """
 
@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 from chain.apparatus.virtual_settings import VirtualExperiment, check_switches
 from chain.errors import ConfigError, ParameterError
 from chain.errors import key_label as key_name
-from chain.pipeline.virtual_config import VIRTUAL_KEYS, virtual_experiment_settings
+from chain.pipeline.config.virtual import VIRTUAL_KEYS, virtual_experiment_settings
 
 #: Keys a variant may set besides those of ``experiment.virtual``.
 EXTRA_KEYS = ("striker_radius_m", "tolerance")

@@ -6,14 +6,14 @@ bead against the collision point, a record interval against the time step and th
 narrowest pulse, a duration against the slowest wave, a detection threshold against the
 smallest pulse, a tolerance against the shots' mismatch, names that must stay apart
 after rounding. :func:`check_bounds` runs them (from
-:func:`chain.pipeline.config.check_config`, before any job), on the run and on every
+:func:`chain.pipeline.config.check.check_config`, before any job), on the run and on every
 ablation variant, and raises :class:`ConfigError` naming the key, as every config check
 does:
 
-* :mod:`chain.pipeline.config_bounds_run`: the simulated run (sensors, simulation, long
+* :mod:`chain.pipeline.config.bounds_run`: the simulated run (sensors, simulation, long
   chains, LAMMPS);
-* :mod:`chain.pipeline.config_bounds_experiment`: the virtual experiment;
-* :mod:`chain.pipeline.config_bounds_table`: the table ``docs/config_bounds.md`` of
+* :mod:`chain.pipeline.config.bounds_experiment`: the virtual experiment;
+* :mod:`chain.pipeline.config.bounds_table`: the table ``docs/config_bounds.md`` of
   every key's smallest and largest value, generated from the schema and its ``RULES``.
 
 This module reads no file and knows no Snakemake.
@@ -25,8 +25,8 @@ import copy
 from collections.abc import Callable, Mapping
 
 from chain.errors import ConfigError, key_label
-from chain.pipeline.config_bounds_experiment import check_experiment_bounds
-from chain.pipeline.config_bounds_run import check_run_bounds
+from chain.pipeline.config.bounds_experiment import check_experiment_bounds
+from chain.pipeline.config.bounds_run import check_run_bounds
 
 
 def variant_config(config: Mapping, overrides: Mapping) -> dict:
@@ -76,9 +76,9 @@ def check_bounds(config: Mapping, check: Callable[[Mapping], None] | None = None
     ----------
     config : mapping
         The config after schema validation (defaults filled in) and the checks of
-        :func:`chain.pipeline.config.check_config` up to the ablation.
+        :func:`chain.pipeline.config.check.check_config` up to the ablation.
     check : callable, optional
-        The whole config check (:func:`chain.pipeline.config.check_config`), run again
+        The whole config check (:func:`chain.pipeline.config.check.check_config`), run again
         on each ablation variant's config (:func:`variant_config`); None skips the
         variants.
 

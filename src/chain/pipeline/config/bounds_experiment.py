@@ -3,7 +3,7 @@ digitiser against the narrowest and the smallest pulse, the sensor spring agains
 given time step, the launch delay against the sensors, the selection tolerance against
 the shots' speed mismatch.
 
-Pulse estimates as in :mod:`chain.pipeline.config_bounds_run`; a striker of mass m_s at
+Pulse estimates as in :mod:`chain.pipeline.config.bounds_run`; a striker of mass m_s at
 V0 hands the chain a momentum between m_s V0 and 2 m_s V0 (it stops, or bounces back),
 so V_m = LAUNCH_VELOCITY_RATIO x (m_s / m) x V0 at the least and twice that at the
 most; a launched bead (``launch: bead``) gives V_m = LAUNCH_VELOCITY_RATIO x V0. Each
@@ -24,7 +24,7 @@ from chain.analysis.pulses import DEFAULT_MIN_SNR
 from chain.physics.materials import get_material, sphere_mass
 from chain.physics.theory import LAUNCH_VELOCITY_RATIO, force_from_bead_velocity
 from chain.physics.time_step import STEPS_PER_SPRING_PERIOD
-from chain.pipeline.config_bounds_run import (
+from chain.pipeline.config.bounds_run import (
     MIN_SENSOR_DISTANCE,
     check_passing,
     check_resolution,
@@ -33,7 +33,7 @@ from chain.pipeline.config_bounds_run import (
     sensor_room,
     slowest_passing,
 )
-from chain.pipeline.virtual_config import virtual_experiment
+from chain.pipeline.config.virtual import virtual_experiment
 
 #: Standard deviations of the random launch jitter a delay bound covers (99.7 % of shots).
 JITTER_SIGMAS = 3.0
@@ -189,7 +189,7 @@ def check_experiment_bounds(config: Mapping) -> None:
     ----------
     config : mapping
         A schema-valid config with ``experiment.source: virtual`` that passed the
-        checks of :func:`chain.pipeline.config.check_config` before the bounds.
+        checks of :func:`chain.pipeline.config.check.check_config` before the bounds.
 
     Raises
     ------

@@ -1,6 +1,6 @@
 """One simulation job as plain values, and the chain and arguments they give.
 
-:meth:`chain.pipeline.plan.RunPlan.simulate_job` writes down, for one model and chain
+:meth:`chain.pipeline.plan.run_plan.RunPlan.simulate_job` writes down, for one model and chain
 of a run, every input that determines what the job computes (the *job inputs*):
 
 ====================  ===========================================================
@@ -19,7 +19,7 @@ of a run, every input that determines what the job computes (the *job inputs*):
 ====================  ===========================================================
 
 The job's output depends on these values and on the code it runs (the rule's code
-inputs, :mod:`chain.pipeline.deps`), on nothing else: no seed (the simulation has no
+inputs, :mod:`chain.pipeline.plan.code`), on nothing else: no seed (the simulation has no
 randomness) and no analysis or figure key. The dict is JSON-serialisable, so that a
 cache of results (issue 33) can hash it; the workflow passes it to the job as a rule
 parameter, and the job builds its chain from it with :func:`chain_of` (the one place a

@@ -79,7 +79,7 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
     Parameters
     ----------
     config : mapping
-        A config that passed :func:`chain.pipeline.config.check_config`.
+        A config that passed :func:`chain.pipeline.config.check.check_config`.
     root : path
         Folder that relative dataset paths start from (the working directory).
 
@@ -181,7 +181,7 @@ def check_experiment_datasets(
     Parameters
     ----------
     config : mapping
-        A config that passed :func:`chain.pipeline.config.check_config`.
+        A config that passed :func:`chain.pipeline.config.check.check_config`.
     parts : sequence of ExperimentPart
         :func:`experiment_parts` of it (virtual parts, whose
         datasets are pipeline outputs, are skipped).

@@ -2,8 +2,8 @@
 (its keys are the fields of :class:`chain.apparatus.virtual.VirtualExperiment`), plus
 the run's material, radius, striker and seed, and the chain.
 
-Its own module so that both :mod:`chain.pipeline.config` (the checks) and
-:mod:`chain.pipeline.ablation_config` (the variants) use it without importing each other.
+Its own module so that both :mod:`chain.pipeline.config.check` (the checks) and
+:mod:`chain.pipeline.config.ablation` (the variants) use it without importing each other.
 """
 
 from __future__ import annotations

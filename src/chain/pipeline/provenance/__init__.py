@@ -1,0 +1,1 @@
+"""Provenance: what made a run (commit, config, versions) and the headline check."""
