@@ -18,9 +18,9 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
-from chain.pipeline.config.check import ConfigError, check_config
 from chain.pipeline.config.bounds import variant_config
 from chain.pipeline.config.bounds_table import CHOICE, RULES, bounds_table, table_rows
+from chain.pipeline.config.check import ConfigError, check_config
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"

@@ -30,10 +30,10 @@ from chain.labels import VIRTUAL_SERIES
 from chain.physics.lammps_library import lammps_available
 from chain.physics.model import ChainModel
 from chain.pipeline.config.ablation import ablation_variants, variant_settings, variant_tolerance
+from chain.pipeline.config.virtual import virtual_experiment_settings
 from chain.pipeline.plan.datasets import ExperimentPart, experiment_label, experiment_parts
 from chain.pipeline.plan.jobs import chain_of
 from chain.pipeline.plan.resources import JobNeeds, simulation_needs, simulation_threads
-from chain.pipeline.config.virtual import virtual_experiment_settings
 from chain.studies.c_sensitivity import sensitivity_plan, shifted_pairs
 from chain.studies.mechanism_settings import (
     CANDIDATE_REFERENCE,
@@ -242,7 +242,7 @@ class RunPlan:
         )
 
     def simulation_threads(self, model: str, n_beads: int) -> int:
-        """Cores a simulate job is worth (:func:`chain.pipeline.plan.resources.simulation_threads`)."""
+        """Cores a simulate job is worth (:func:`.resources.simulation_threads`)."""
         job = self.simulate_job(model, n_beads)
         return simulation_threads(
             chain_of(job), len(self.speeds), max(self.speeds), job["duration_s"], job["time_step_s"]
