@@ -33,18 +33,11 @@ include: "workflow/rules/common.smk"
 rule all:
     default_target: True
     input:
-        final_targets,
+        target_inputs("all"),
 
 
-include: "workflow/rules/simulate.smk"
-include: "workflow/rules/experiment.smk"
-include: "workflow/rules/analyse.smk"
-include: "workflow/rules/figures.smk"
-include: "workflow/rules/report.smk"
-include: "workflow/rules/article.smk"
-include: "workflow/rules/sweep.smk"
-include: "workflow/rules/ablation.smk"
-include: "workflow/rules/mechanisms.smk"
+include: "workflow/rules/targets.smk"
+include: "workflow/rules/steps.smk"
 
 
 # The import statements every rule's code() read, for the next command (common.smk).

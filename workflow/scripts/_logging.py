@@ -4,7 +4,8 @@ import logging
 import signal
 import sys
 
-from chain.pipeline.run.job_script import stop_once
+#: Exit status of a job stopped by a signal: the shell's convention, 128 + signal.
+SIGNAL_BASE = 128
 
 
 def start(snakemake) -> logging.Logger:
@@ -33,6 +34,18 @@ def start(snakemake) -> logging.Logger:
     logger.info("inputs: %s", list(snakemake.input))
     logger.info("outputs: %s", list(snakemake.output))
     return logger
+
+
+def stop_once(signum: int, frame) -> None:
+    """Signal handler: end the job as SIGINT (KeyboardInterrupt) or SIGTERM (SystemExit
+    with status 128 + signal) do, once; later SIGINT and SIGTERM are ignored, so that a
+    signal that arrives twice (sent to a process group, and passed on by a parent)
+    cannot cut the atomic writers' clean-up short."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise SystemExit(SIGNAL_BASE + signum)
 
 
 def _use_job_threads(threads: int | None) -> None:

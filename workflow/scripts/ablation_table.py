@@ -2,7 +2,6 @@
 (chain.studies.ablation_table.ablation_table): the rows of the run's main estimator
 (params estimator; each variant's job fits every estimator)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -3,7 +3,6 @@ fits and SSW fits at S2 with every estimator of the run (chain.studies.ablation)
 replicate with the run's own settings reads the run's virtual experiment (input
 datasets, where params reads_run says so) instead of simulating it again."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

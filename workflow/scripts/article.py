@@ -2,7 +2,6 @@
 
 import json
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.report.text.article import article_numbers, compile_article

@@ -2,7 +2,6 @@
 (chain.studies.c_sensitivity), on simulated shots, with each estimator as the headline
 one (rule c_sensitivity_table writes the main one's as tables/c_sensitivity.csv)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.apparatus.shots import simulate_shots

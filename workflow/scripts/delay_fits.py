@@ -1,6 +1,5 @@
 """Fits of |Delta| = C F_m^(-1/6) and of a free power law (chain.analysis.recipe)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

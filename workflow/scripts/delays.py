@@ -1,6 +1,5 @@
 """Crossing delay of every collision shot (chain.analysis.delays.delay_table)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _inputs import selection
 from _logging import start

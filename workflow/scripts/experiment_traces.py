@@ -1,6 +1,5 @@
 """Every experiment dataset (measured-trace format) as a trace table (chain.apparatus.measured)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _inputs import dataset_folders
 from _logging import start
 

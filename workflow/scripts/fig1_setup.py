@@ -2,7 +2,6 @@
 
 from pathlib import Path
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.report.figures.fig1_setup import fig1_setup

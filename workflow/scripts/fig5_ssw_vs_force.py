@@ -3,7 +3,6 @@ the chain (chain.report.figures.fig5_ssw_vs_force)."""
 
 from pathlib import Path
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -2,7 +2,6 @@
 
 from pathlib import Path
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -1,7 +1,6 @@
 """LAMMPS against our kernel in the frictionless 1D limit (chain.studies.lammps_check),
 with every estimator of the run (rule lammps_check_table picks the main one)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.atomic import write_csv_atomic

@@ -1,7 +1,6 @@
 """One friction/rotation setting on one chain, run by LAMMPS and analysed
 (chain.studies.lammps_sweep.run_sweep_setting), with every estimator of the run."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.atomic import write_csv_atomic

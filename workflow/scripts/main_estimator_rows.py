@@ -1,7 +1,6 @@
 """A study's table for the run's main estimator: its job computed it for every
 estimator, tagged in column params.column (chain.analysis.rows.picked)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

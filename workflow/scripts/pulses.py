@@ -1,6 +1,5 @@
 """Fit the pulses of every trace file (chain.analysis.pulse_rows.pulse_table)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

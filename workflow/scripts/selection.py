@@ -1,6 +1,5 @@
 """The paper's acceptance protocol on the experiment shots (chain.analysis.selection)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _inputs import dataset_folders
 from _logging import start

@@ -1,6 +1,5 @@
 """Simulate one model on one chain for every launch speed (chain.apparatus.shots)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.apparatus.shots import simulate_shots

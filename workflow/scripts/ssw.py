@@ -1,6 +1,5 @@
 """Secondary solitary waves behind every crossed pulse (chain.analysis.ssw.ssw_table)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _inputs import selection
 from _logging import start

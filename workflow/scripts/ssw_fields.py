@@ -5,7 +5,6 @@ Only the shown shot is integrated again, at the time step of the whole batch of
 ssw_track, which makes it the same numbers bit for bit: a figure key (which collision
 is shown) recomputes milliseconds of integration, not the tracks."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -1,6 +1,5 @@
 """Fits of SSW amplitude = slope x F_m (chain.analysis.ssw.ssw_fit_table)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

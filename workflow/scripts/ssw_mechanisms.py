@@ -3,7 +3,6 @@ friction/rotation sweep and the virtual experiment's candidates
 (chain.studies.mechanism_table). The study's jobs fit every estimator; the run's main
 one is taken here (params estimator)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -1,7 +1,6 @@
 """The SSW tracks of every chain in one table, and their speeds against Eq. 5
 (chain.analysis.ssw_speed.ssw_speed_table)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

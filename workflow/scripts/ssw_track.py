@@ -1,7 +1,6 @@
 """Re-simulate one chain's collisions with every contact recorded and track the SSW
 (chain.analysis.ssw_track). The field Fig. ssw_spacetime shows: ssw_fields.py."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.analysis.ssw_track import ssw_track_table

@@ -1,6 +1,5 @@
 """summary.json: the run's numbers beside the paper's (chain.report.numbers.summary)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _inputs import selection
 from _logging import start

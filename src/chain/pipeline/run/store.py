@@ -24,7 +24,7 @@ import shutil
 import stat
 from pathlib import Path
 
-from chain.atomic import ordinary_mode, write_text_atomic
+from chain.atomic import ordinary_mode
 
 #: Environment variable naming the store's folder (default :data:`DEFAULT_FOLDER`).
 STORE_VARIABLE = "HERTZCHAIN_STORE"
@@ -32,8 +32,6 @@ STORE_VARIABLE = "HERTZCHAIN_STORE"
 GROUP_VARIABLE = "HERTZCHAIN_STORE_GROUP"
 #: The store's folder relative to the working directory: ``rm -r results`` empties it.
 DEFAULT_FOLDER = Path("results") / ".store"
-#: Checksum file of a run folder, in the format ``sha256sum -c`` reads.
-CHECKSUMS = "SHA256SUMS"
 
 _CHUNK = 1 << 20  # bytes read at a time
 
@@ -99,7 +97,9 @@ class Store:
         self.folder_mode = 0o700 if group is None else 0o2770
 
     @classmethod
-    def open(cls, environ, working_directory: str | os.PathLike = ".") -> Store:
+    def open(
+        cls, environ, working_directory: str | os.PathLike = ".", create: bool = True
+    ) -> Store | None:
         """The store the environment names (:data:`STORE_VARIABLE`, relative to
         ``working_directory``; default :data:`DEFAULT_FOLDER`), made if missing; refused
         (:class:`StoreError`) if another user owns it or others may write it.
@@ -110,6 +110,8 @@ class Store:
             The process environment.
         working_directory : path
             Where a relative store folder starts (Snakemake's working directory).
+        create : bool
+            Make the folder if it is missing; else a missing store is None.
         """
         root = Path(working_directory) / (environ.get(STORE_VARIABLE) or DEFAULT_FOLDER)
         group = environ.get(GROUP_VARIABLE) or None
@@ -118,6 +120,8 @@ class Store:
         except KeyError:
             raise StoreError(f"{GROUP_VARIABLE}={group}: no such group") from None
         store = cls(root, gid)
+        if not create and not root.is_dir():
+            return None
         try:
             root.mkdir(parents=True, exist_ok=True, mode=store.folder_mode)
         except OSError as error:
@@ -180,6 +184,39 @@ class Store:
             os.replace(copy, out)
         return manifest
 
+    def verify(self, key: str, count: int) -> dict | None:
+        """Check ``key``'s entry of ``count`` outputs, every file against its manifest,
+        without copying or changing anything; its manifest, or None if there is none.
+
+        Raises
+        ------
+        BadEntry
+            The entry is damaged (the message names the file).
+        """
+        entry = self.entry(key)
+        if not entry.is_dir():
+            return None
+        manifest = self._manifest(entry, count)
+        for i, files in enumerate(manifest["outputs"]):
+            stored = entry / "files" / str(i)
+            found = set(_files_under(stored)) if stored.is_dir() else {""}
+            if found != set(files):
+                raise BadEntry(f"{stored.name}: files {sorted(found ^ set(files))} differ")
+            for name, (sha256, size) in files.items():
+                got = _hash_regular(stored / name if name else stored)
+                if got != (sha256, size):
+                    raise BadEntry(f"files/{i}{'/' + name if name else ''}: SHA-256 "
+                                   f"{got[0][:12]}... ({got[1]} bytes), stored as "
+                                   f"{sha256[:12]}... ({size} bytes)")  # fmt: skip
+        return manifest
+
+    def recorded(self, key: str) -> dict | None:
+        """``key``'s manifest as recorded (unchecked), or None if absent or unreadable."""
+        try:
+            return json.loads((self.entry(key) / "manifest.json").read_text())
+        except (OSError, ValueError):
+            return None
+
     def _manifest(self, entry: Path, count: int) -> dict:
         try:
             manifest = json.loads((entry / "manifest.json").read_text())
@@ -213,10 +250,11 @@ class Store:
             raise
         return copy
 
-    def put(self, key: str, outputs: list[str], about: dict, replace: bool = False) -> bool:
+    def put(self, key: str, outputs: list[str], about: dict, replace: bool = False) -> dict:
         """Store the files ``outputs`` (paths, in order) under ``key``, with ``about``
         (who stored them) in the manifest. An existing entry is kept (another run
-        stored the same result) unless ``replace``. Returns whether this call stored.
+        stored the same result) unless ``replace``. Returns the manifest of the entry
+        that stands: each output's files with their SHA-256 and size.
         """
         tmp = self.root / "tmp"
         tmp.mkdir(exist_ok=True, mode=self.folder_mode)
@@ -227,18 +265,18 @@ class Store:
             records = [
                 self._stage(Path(out), staging / "files" / str(i)) for i, out in enumerate(outputs)
             ]
-            manifest = staging / "manifest.json"
-            manifest.write_text(json.dumps({**about, "key": key, "outputs": records}, indent=1))
-            os.chmod(manifest, self.file_mode)
+            manifest = {**about, "key": key, "outputs": records}
+            (staging / "manifest.json").write_text(json.dumps(manifest, indent=1))
+            os.chmod(staging / "manifest.json", self.file_mode)
             final = self.entry(key)
             final.parent.mkdir(exist_ok=True, mode=self.folder_mode)
             if replace and final.exists():
                 self.discard(key)
             os.rename(staging, final)
-            return True
+            return manifest
         except OSError as error:
             if error.errno in (errno.EEXIST, errno.ENOTEMPTY) and self.entry(key).is_dir():
-                return False  # stored meanwhile by another run: one entry is kept
+                return {**manifest, **(self.recorded(key) or {})}  # stored meanwhile
             raise
         finally:
             _remove(staging)
@@ -284,27 +322,24 @@ def _copy_hashing(source: Path, target: Path) -> tuple[str, int]:
     return digest.hexdigest(), size
 
 
+def _hash_regular(path: Path) -> tuple[str, int]:
+    """(SHA-256, size) of a regular file, never through a link."""
+    digest, size = hashlib.sha256(), 0
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
+    except OSError as error:
+        raise BadEntry(f"{path.name}: {error.strerror}") from None
+    with open(fd, "rb") as stream:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise BadEntry(f"{path.name} is not a regular file")
+        while chunk := stream.read(_CHUNK):
+            digest.update(chunk)
+            size += len(chunk)
+    return digest.hexdigest(), size
+
+
 def _remove(path: Path) -> None:
     if path.is_dir() and not path.is_symlink():
         shutil.rmtree(path, ignore_errors=True)
     else:
         path.unlink(missing_ok=True)
-
-
-def write_checksums(folder: str | os.PathLike) -> Path:
-    """Write ``<folder>/SHA256SUMS``: every other file below ``folder`` with its SHA-256,
-    as ``sha256sum -c`` reads it (run from ``folder``). Returns its path.
-
-    Parameters
-    ----------
-    folder : path
-        A run folder (``results/<run_name>``).
-    """
-    folder = Path(folder)
-    lines = [
-        f"{file_digest(folder / name)}  {name}\n"
-        for name in _files_under(folder)
-        if name != CHECKSUMS and not Path(name).name.startswith(".")
-    ]
-    write_text_atomic("".join(lines), folder / CHECKSUMS)
-    return folder / CHECKSUMS

@@ -1,0 +1,60 @@
+"""The run folder's ``SHA256SUMS``: every file of a run folder that succeeded, with its
+SHA-256, in the format ``sha256sum -c SHA256SUMS`` reads (run from the folder).
+
+It certifies a complete run only: written once every target has succeeded, from the
+digests the run checked as it fetched and stored its results (a file changed since is
+then reported by ``sha256sum -c``), and removed as soon as a run starts work, so that a
+failed or interrupted run leaves none. Hidden files and folders (an interrupted copy's
+staging, Snakemake's ``.snakemake_timestamp``) are never listed.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+from chain.atomic import write_text_atomic
+from chain.pipeline.run.store import file_digest
+
+#: The checksum file of a run folder.
+CHECKSUMS = "SHA256SUMS"
+
+
+def run_files(folder: str | os.PathLike) -> list[str]:
+    """Every file below ``folder`` but the checksums, as sorted relative POSIX paths; no
+    path with a hidden part."""
+    root = Path(folder)
+    found = []
+    for base, folders, files in os.walk(root):
+        folders[:] = [f for f in folders if not f.startswith(".")]
+        found += [
+            (Path(base) / name).relative_to(root).as_posix()
+            for name in files
+            if not name.startswith(".") and not os.path.islink(Path(base) / name)
+        ]
+    return sorted(name for name in found if name != CHECKSUMS)
+
+
+def write_checksums(folder: str | os.PathLike, digests: Mapping[str, str] = {}) -> Path:
+    """Write ``<folder>/SHA256SUMS``. Returns its path.
+
+    Parameters
+    ----------
+    folder : path
+        A run folder (``results/<run_name>``).
+    digests : mapping, optional
+        Path (as the run names it: ``results/<run_name>/...``) -> SHA-256 the run
+        checked; any other file is hashed now.
+    """
+    lines = []
+    for name in run_files(folder):
+        path = os.path.join(folder, name)
+        lines.append(f"{digests.get(path) or file_digest(path)}  {name}\n")
+    write_text_atomic("".join(lines), Path(folder) / CHECKSUMS)
+    return Path(folder) / CHECKSUMS
+
+
+def remove_checksums(folder: str | os.PathLike) -> None:
+    """Remove ``<folder>/SHA256SUMS``: the folder no longer holds a complete run."""
+    (Path(folder) / CHECKSUMS).unlink(missing_ok=True)
