@@ -213,12 +213,14 @@ def test_both_patches_apply_to_the_locked_snakemake_without_a_word():
     assert getattr(Scheduler, SIGTERM_METHOD)._off_the_main_thread
 
 
-def test_another_release_is_named_with_the_behaviour_that_is_then_its_own():
-    class Other:  # a release that renamed the wake-up and kept the handler
-        def exit_gracefully(self, *args):
-            pass
+def test_another_release_is_left_as_it_is_and_said_so_in_one_line():
+    class Other(JobScheduler):
+        pass
 
+    own = (getattr(Other, WAKEUP_METHOD), getattr(Other, SIGTERM_METHOD))
     lines = patch_snakemake(Other, "10.0.0")
-    assert lines[0].startswith("hertzchain: Snakemake 10.0.0, not " + WRITTEN_FOR)
-    assert "NOT applied" in lines[1] and "wake-up timers multiply" in lines[1]
-    assert "applied, untested" in lines[2] and "SIGTERM" in lines[2]
+    assert (getattr(Other, WAKEUP_METHOD), getattr(Other, SIGTERM_METHOD)) == own
+    assert len(lines) == 1 and lines[0].startswith("hertzchain: Snakemake 10.0.0: the ")
+    assert "stay off" in lines[0] and "wake-up timers multiply" in lines[0]
+    assert "SIGTERM" in lines[0] and "docs/upstream/README.md" in lines[0]
+    assert (ROOT / "docs" / "upstream" / "README.md").is_file()

@@ -1,6 +1,6 @@
 """Two defects of Snakemake's scheduler that a run of this workflow meets, patched from
 the Snakefile until Snakemake fixes them; each is written up with a reproducer that
-needs no part of this workflow in ``docs/snakemake_defects.md``.
+needs no part of this workflow in ``docs/upstream/`` (``docs/upstream/README.md``).
 
 * **Wake-ups multiply** (:func:`coalesce_wakeups`). ``JobScheduler`` ends each pass of
   its loop in which jobs were ready with a ``threading.Timer`` that wakes the loop
@@ -17,11 +17,11 @@ needs no part of this workflow in ``docs/snakemake_defects.md``.
   SIGTERM in that window (``kill PID``; a batch system's cancel) makes the main thread
   wait for itself, for good.
 
-Each patch checks that the method it replaces is there and does nothing otherwise;
-:func:`patch_snakemake` says on the console when the running Snakemake is not the one
-the patches were written for (:data:`WRITTEN_FOR`), and which behaviour is then
-Snakemake's own. ``tests/test_snakemake_patches.py`` fails when they no longer apply to
-the locked Snakemake.
+The patches replace private methods of Snakemake's scheduler, so they are applied only
+on the release they were written for (:data:`WRITTEN_FOR`, the locks' release); on any
+other, :func:`patch_snakemake` leaves Snakemake as it is and says so in one line.
+``tests/test_snakemake_patches.py`` fails when they no longer apply to the locked
+Snakemake.
 """
 
 from __future__ import annotations
@@ -119,8 +119,8 @@ def stop_gracefully_off_the_main_thread(scheduler_class) -> bool:
 
 
 def patch_snakemake(scheduler_class, version: str) -> list[str]:
-    """Apply both patches to ``scheduler_class``; the lines to say on the console: none
-    for the Snakemake they were written for, else which behaviour is Snakemake's own.
+    """Apply both patches to ``scheduler_class`` on the Snakemake release they were
+    written for; the console's lines: none then, else one saying they are off.
 
     Parameters
     ----------
@@ -129,17 +129,12 @@ def patch_snakemake(scheduler_class, version: str) -> list[str]:
     version : str
         The running Snakemake's version.
     """
-    applied = {
-        WAKEUP_METHOD: coalesce_wakeups(scheduler_class),
-        SIGTERM_METHOD: stop_gracefully_off_the_main_thread(scheduler_class),
-    }
-    if version == WRITTEN_FOR and all(applied.values()):
-        return []
-    lines = [
-        f"hertzchain: Snakemake {version}, not {WRITTEN_FOR}, the release its two "
-        "scheduler patches were written for (docs/snakemake_defects.md):"
-    ]
-    for method, done in applied.items():
-        state = "applied, untested on this release" if done else "NOT applied"
-        lines.append(f"  {method}: {state}; without it {UNPATCHED[method]}")
-    return lines
+    if version != WRITTEN_FOR:
+        return [
+            f"hertzchain: Snakemake {version}: the scheduler patches written for "
+            f"{WRITTEN_FOR} stay off ({'; '.join(UNPATCHED.values())}; "
+            "docs/upstream/README.md)"
+        ]
+    coalesce_wakeups(scheduler_class)
+    stop_gracefully_off_the_main_thread(scheduler_class)
+    return []
