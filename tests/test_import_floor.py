@@ -99,7 +99,7 @@ CASES = {
         {"numba", "scipy", "pandas", "matplotlib"},
     ),
     # What the Snakefile runs before any job (common.smk): every snakemake command, a
-    # dry run included, pays it.
+    # dry run included, pays it: the plan, every job of the run and their requests.
     "the workflow's parse: config checks, run plan, job resources": (
         [
             "import yaml",
@@ -110,10 +110,10 @@ CASES = {
             f"validate(config, {str(ROOT / 'workflow' / 'schemas' / 'config.schema.yaml')!r})",
             "check_config(config)",
             "plan = RunPlan(config)",
-            "chains = [*plan.chains, *plan.long_chains]",
-            "jobs = [plan.simulate_job(m, n) for m in plan.models for n in chains]",
-            "needs = [plan.simulation_needs(m, n, plan.simulation_threads(m, n))"
-            " for m in plan.models for n in chains]",
+            "jobs = plan.jobs.needed(plan.targets())",
+            "sim = plan.simulation",
+            "needs = [sim.mem_mb(job.wildcards, sim.threads(job.wildcards))"
+            " for job in jobs if job.rule == 'simulate']",
         ],
         {"numba", "scipy", "matplotlib"},
     ),

@@ -61,8 +61,8 @@ def test_launch_speeds_are_the_configured_geometric_series(plan):
     assert np.diff(np.log(speeds)) == pytest.approx(np.log(1.0 / 0.021) / 11, rel=1e-9)
     # Every simulation of the run, the C-sensitivity study's too, launches at them.
     assert plan.simulate_job("elastic", 25)["speeds_m_s"] == list(plan.speeds)
-    assert plan.c_sensitivity["speeds_m_s"] == list(plan.speeds)
-    assert all(job["speeds_m_s"] == list(plan.speeds) for job in plan.c_sensitivity_jobs())
+    assert plan.c_sensitivity.choices["speeds_m_s"] == list(plan.speeds)
+    assert all(job["speeds_m_s"] == list(plan.speeds) for job in plan.c_sensitivity.jobs())
 
 
 def test_the_chain_follows_the_readout(paper):
@@ -78,12 +78,12 @@ def test_the_chain_follows_the_readout(paper):
 
 def test_conservative_models_and_the_spacetime_model(paper, plan):
     assert plan.conservative == ("elastic",)
-    assert plan.spacetime_model == "elastic"
+    assert plan.simulation.spacetime_model == "elastic"
     dissipative = copy.deepcopy(paper)
     dissipative["models"] = [{"name": "viscoelastic", "eta_s": 0.58e-6}]
     dissipative["figures"]["traces_model"] = "viscoelastic"
     other = RunPlan(dissipative)
-    assert other.conservative == () and other.spacetime_model == "viscoelastic"
+    assert other.conservative == () and other.simulation.spacetime_model == "viscoelastic"
 
 
 def test_durations_and_long_chains(paper, plan):
@@ -98,28 +98,29 @@ def test_durations_and_long_chains(paper, plan):
 
 
 def test_the_virtual_experiment_takes_the_config_names(paper, plan):
-    settings = plan.virtual_experiment(26)
+    settings = plan.experiment.model(26)
     virtual = paper["experiment"]["virtual"]
     for key, value in virtual.items():
         got = getattr(settings, key)
         assert got == (tuple(value) if isinstance(value, list) else value), key
     assert settings.seed == paper["seed"] + 26 and settings.sensor_beads == (10, 17)
     assert settings.striker_radius == paper["setup"]["striker_radius_m"]
-    assert json.loads(json.dumps(plan.virtual_settings(26))) == plan.virtual_settings(26)
+    settings = plan.experiment.settings(26)
+    assert json.loads(json.dumps(settings)) == settings
 
 
 def test_targets_follow_the_experiment_and_the_studies(paper, plan):
-    assert plan.experiment_label == "virtual experiment (model)"
+    assert plan.experiment.label == "virtual experiment (model)"
     assert f"{plan.tables}/ablation_exponent.csv" in plan.targets()
-    assert "fig2_experiment_traces" in plan.figure_names()
+    assert "fig2_experiment_traces" in plan.figures.names()
     none = copy.deepcopy(paper)
     none["experiment"]["source"] = "none"
     none["studies"]["mechanisms"] = False
     bare = RunPlan(none)
-    assert bare.experiment == () and bare.experiment_label == "experiment"
-    assert "fig2_experiment_traces" not in bare.figure_names()
-    assert bare.optional_table("ablation_exponent") == []
-    assert bare.candidates(full=True) == {} and not bare.lammps
+    assert bare.experiment.chains == () and bare.experiment.label == "experiment"
+    assert "fig2_experiment_traces" not in bare.figures.names()
+    assert bare.ablation.targets() == []
+    assert bare.mechanisms.candidates(full=True) == {} and not bare.mechanisms.lammps
     assert not any("ssw_mechanisms" in path for path in bare.targets())
 
 
@@ -144,7 +145,7 @@ def test_a_study_switched_off_leaves_exactly_its_files(paper, plan, study):
     assert own <= set(plan.targets())
     if study == "mechanisms":
         own |= {path for path in plan.targets() if "lammps_check" in path}
-        assert not off.lammps and off.candidates(full=False) == {}
+        assert not off.mechanisms.lammps and off.mechanisms.candidates(full=False) == {}
     assert set(off.targets()) == set(plan.targets()) - own
     assert off.studies_not_run == [study] and plan.studies_not_run == []
 
@@ -157,34 +158,34 @@ def test_the_paper_run_makes_every_study_and_the_schema_defaults_to_all(paper):
 
 
 def test_variants_with_the_runs_settings_read_the_runs_virtual_experiment(plan):
-    raw = [plan.raw_dataset(n) for n in plan.chains]
+    raw = [plan.experiment.raw_dataset(n) for n in plan.chains]
     assert raw == [f"{plan.out}/experiment/raw/N25", f"{plan.out}/experiment/raw/N26"]
     # The reference of the candidates and a tolerance-only variant are the run's own
     # shots; of as_configured's 8 seeds, the first is the run's.
-    assert plan.ablation_datasets("mechanism_reference") == [raw]
-    assert plan.ablation_datasets("no_selection") == [raw]
-    assert plan.ablation_datasets("as_configured") == [raw] + [[]] * 7
-    assert plan.ablation_tolerance("no_selection") is None
+    assert plan.ablation.datasets("mechanism_reference") == [raw]
+    assert plan.ablation.datasets("no_selection") == [raw]
+    assert plan.ablation.datasets("as_configured") == [raw] + [[]] * 7
+    assert plan.ablation.tolerance("no_selection") is None
     # Any change to the shots (one seed, one switch) simulates anew.
     for name in ("no_reference_mismatch", "no_noise_adc", "kk_2us", "off_centre_5pct"):
-        assert plan.ablation_datasets(name) == [[]], name
+        assert plan.ablation.datasets(name) == [[]], name
 
 
 def test_only_a_virtual_run_shares_its_experiment(paper):
     config = copy.deepcopy(paper)
     config["experiment"]["source"] = "none"
-    assert RunPlan(config).ablation_datasets("mechanism_reference") == [[]]
+    assert RunPlan(config).ablation.datasets("mechanism_reference") == [[]]
 
 
 def test_identical_variants_are_twins_of_the_first(paper, plan):
-    assert plan.ablation_twins == {"sensor_bead_off": "point_readout"}
-    assert plan.ablation_settings("sensor_bead_off") == plan.ablation_settings("point_readout")
+    assert plan.ablation.twins == {"sensor_bead_off": "point_readout"}
+    assert plan.ablation.settings("sensor_bead_off") == plan.ablation.settings("point_readout")
     # Another tolerance makes another analysis: no longer a twin.
     config = copy.deepcopy(paper)
     for variant in config["ablation"]["variants"]:
         if variant["name"] == "sensor_bead_off":
             variant["set"]["tolerance"] = 0.1
-    assert RunPlan(config).ablation_twins == {}
+    assert RunPlan(config).ablation.twins == {}
 
 
 def test_the_plan_is_frozen_and_keeps_its_own_config(paper):

