@@ -14,6 +14,7 @@ import yaml
 from snakemake.utils import validate
 
 from chain.pipeline.config.check import check_config
+from chain.pipeline.plan import figures
 from chain.pipeline.plan.jobs import JOB_KEYS, chain_of
 from chain.pipeline.plan.run_plan import RunPlan
 
@@ -195,3 +196,46 @@ def test_the_plan_is_frozen_and_keeps_its_own_config(paper):
     assert len(plan.speeds) == 12 and plan.config["launch"]["count"] == 12
     with pytest.raises(dataclasses.FrozenInstanceError):
         plan.speeds = ()
+
+
+def test_a_figure_registered_once_is_a_target_a_report_entry_and_in_the_article(paper, monkeypatch):
+    """One entry in the figure registry, and the run asks for the figure, makes a rule
+    for it (its script by its name, the PNG for the HTML report), and the article embeds
+    it; the workflow end to end: tests/test_workflow.py (report and article)."""
+    entry = figures.Figure(
+        "fig_ssw_speed", inputs=lambda p: {"speed": p.analysis.table("ssw_speed")}
+    )
+    monkeypatch.setattr(figures, "FIGURES", (*figures.FIGURES, entry))
+    plan = RunPlan(paper)
+    pdf, png = (f"{plan.figures_dir}/fig_ssw_speed.{ext}" for ext in ("pdf", "png"))
+    assert {pdf, png} <= set(plan.targets())
+    (step,) = [s for s in plan.steps if s.name == "fig_ssw_speed"]
+    assert step.script_name == "fig_ssw_speed" and step.report == {
+        "png": ("fig_ssw_speed.rst", "Figures")
+    }
+    job = plan.jobs.producer(png)
+    assert job.outputs == {"pdf": pdf, "png": png}
+    assert job.inputs["speed"] == f"{plan.tables}/ssw_speed.csv"
+    assert job.log == f"{plan.out}/logs/figures/fig_ssw_speed.log"
+    assert pdf in plan.jobs.producer(f"{plan.out}/article.pdf").inputs["figures"]
+    assert plan.jobs.producer(png) in plan.jobs.needed(plan.targets())
+
+
+def test_the_plan_knows_every_job_of_the_run_and_what_each_reads(plan):
+    """The default run's jobs, each after the jobs it reads from; each wildcard held to
+    the plan's values, so that Snakemake's rules make exactly these jobs."""
+    jobs = plan.jobs.needed(plan.targets())
+    seen = set()
+    for job in jobs:
+        for path in job.input_paths:
+            producer = plan.jobs.producer(path)
+            assert producer is None or id(producer) in seen, (job, path)
+        seen.add(id(job))
+    rules = {}
+    for job in jobs:
+        rules[job.rule] = rules.get(job.rule, 0) + 1
+    assert rules["simulate"] == 4 and rules["ssw_track"] == 8 and rules["pulses"] == 1
+    simulate = plan.jobs.steps["simulate"]
+    assert simulate.constraints() == {"model": "elastic|viscoelastic", "N": "25|26"}
+    assert set(plan.target_files(["ablation"])) == {f"{plan.tables}/ablation_exponent_all.csv"}
+    assert plan.target_files([]) == plan.targets()

@@ -65,6 +65,12 @@ RUN_TABLE_COLUMNS = {
     ],
 }  # fmt: skip
 
+#: Rules that integrate a chain (or run LAMMPS): an analysis what-if starts none.
+SIMULATIONS = (
+    "simulate", "virtual_experiment", "ssw_track", "ssw_fields", "lammps_setting",
+    "lammps_check", "ablation_variant", "c_sensitivity",
+)  # fmt: skip
+
 FIGURES = [
     "fig1_setup",
     "fig2_experiment_traces",
@@ -356,7 +362,7 @@ def test_a_copied_checkout_has_nothing_to_do(tiny, tmp_path):
     assert planned_jobs(copy, env) == {}
 
 
-# ---- reuse across runs (issue 52; chain.pipeline.run.reuse, chain.pipeline.run.store) ---------
+# ---- reuse across runs (chain.pipeline.run.reuse, chain.pipeline.run.store) -------------
 
 #: What a run states about itself (its name, provenance): made anew by every run.
 PER_RUN_LOGS = {"summary.log", "summary_md.log", "article.log"}
@@ -372,8 +378,14 @@ def ran(out: Path) -> set[str]:
     return {
         str(p.relative_to(logs))
         for p in logs.rglob("*.log")
-        if not p.read_text().startswith("reused from the store: ")
+        if not p.read_text().startswith("taken from the store: ")
     }
+
+
+def started(output: str) -> set[str]:
+    """The rules of the jobs Snakemake started (or, dry, would start): its output's
+    ``rule <name>:`` lines."""
+    return set(re.findall(r"^(?:local)?rule (\w+):$", output, re.M)) - {"all"}
 
 
 def differing_results(a: Path, b: Path) -> list[str]:
@@ -402,8 +414,9 @@ def same_summary(a: Path, b: Path) -> bool:
 
 
 def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
-    """The same config under another run name runs no job but those stating the run, and
-    its results are the first run's bytes."""
+    """The same config under another run name starts no job but those stating the run
+    (Snakemake never sees the others: the store filled the run folder before it looked),
+    and its results are the first run's bytes."""
     work, out, env, _ = checkout_copy(tiny[0], tmp_path)
     result = run(
         ["--cores", "2", "--configfile", str(TINY), "--config", "run_name=again"], work, env
@@ -412,12 +425,13 @@ def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
     again = work / "results" / "again"
     assert ran(again) == PER_RUN_LOGS
     assert differing_results(out, again) == [] and same_summary(out, again)
-    # The forecast at the start, and the tally at the end, agree with what ran.
+    assert started(result.stdout + result.stderr) == {"summary", "summary_md", "article"}
+    # The line before the first job, and the tally at the end, agree with what ran.
     forecast = re.search(r"(\d+) of (\d+) jobs take a stored result, (\d+) compute", result.stdout)
     assert forecast, result.stdout[-3000:]
     reused, jobs, computed = map(int, forecast.groups())
     assert computed == len(PER_RUN_LOGS) and reused + computed == jobs > 30
-    tally = f"hertzchain store: {reused} results reused, {computed} computed"
+    tally = f"hertzchain store: {reused} results taken, {computed} computed and stored"
     assert tally in result.stdout + result.stderr
 
 
@@ -430,8 +444,16 @@ def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
     overlay = tmp_path / "peak.yaml"
     overlay.write_text("run_name: peak\nanalysis:\n  main_estimator: peak\n")
     args = ["--cores", "2", "--configfile", str(TINY), str(overlay)]
+    dry = run(["-n", *args], work, env)
+    assert dry.returncode == 0, (dry.stdout + dry.stderr)[-5000:]
+    assert not (work / "results" / "peak").exists()  # a dry run writes nothing
     result = run(args, work, env)
     assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+    # Snakemake starts (and its dry run lists) exactly the jobs that compute, and no
+    # simulation among them.
+    rules = started(result.stdout + result.stderr)
+    assert rules == started(dry.stdout + dry.stderr)
+    assert not rules & set(SIMULATIONS), rules
     jobs = ran(work / "results" / "peak")
     simulations = {
         j
@@ -457,8 +479,8 @@ def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     result = run(args, work, {**env, "PYTHONHASHSEED": "2"})
     output = result.stdout + result.stderr
     assert result.returncode == 0, output[-5000:]
-    assert "hertzchain store: forced, the results replace the stored: " in output
-    assert "hertzchain store: 0 results reused" in output and "differ" not in output
+    assert "hertzchain store: forced, results replace: the run's " in output
+    assert "hertzchain store: 0 results taken" in output and "differ" not in output
     assert ran(out) == {str(p.relative_to(out / "logs")) for p in (out / "logs").rglob("*.log")}
     assert sorted(p.name for p in store.glob("??/*")) == stored
     assert differing_results(tiny[1], out) == [] and same_summary(tiny[1], out)

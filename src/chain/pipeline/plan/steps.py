@@ -123,10 +123,9 @@ class Step:
         """Wildcard -> regular expression matching exactly the values of :attr:`jobs`
         (one that matches nothing when there is no job), so that Snakemake's rule
         for this step makes just the plan's jobs."""
-        return {
-            name: "|".join(re.escape(str(job[name])) for job in self.jobs) or "(?!)"
-            for name in self.wildcard_names
-        }
+        values = {name: dict.fromkeys(str(job[name]) for job in self.jobs)
+                  for name in self.wildcard_names}  # fmt: skip
+        return {name: "|".join(map(re.escape, v)) or "(?!)" for name, v in values.items()}
 
     def job(self, wildcards: Mapping, code: Callable[[str], list[str]]) -> Job:
         """The job of these wildcard values.
