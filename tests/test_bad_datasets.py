@@ -10,7 +10,12 @@ sensors 9 and 17, sampling 2 us) with ``samples: 800`` added to its metadata.
 
 from __future__ import annotations
 
+import json
+import os
 import shutil
+import stat
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,13 +27,17 @@ from hypothesis import strategies as st
 from chain.apparatus.dataset_check import check_dataset
 from chain.apparatus.measured import MeasuredDataError, load_dataset
 from chain.errors import ConfigError
+from chain.pipeline.plan.code import module_sources
 from chain.pipeline.plan.datasets import (
+    CHECK_MODULE,
+    check_code_digest,
     check_experiment_datasets,
     experiment_parts,
     skipped_shot_rows,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "src" / "chain"
 EXAMPLE = ROOT / "tests" / "data" / "virtual_small"
 SHOT = "shot_0001.csv"
 ROWS = 800
@@ -362,6 +371,74 @@ def test_verdicts_are_cached_by_content(dataset, tmp_path):
     shutil.copytree(dataset, copy_)
     again = check_dataset(copy_, cache_dir=cache)
     assert all(str(copy_) in p for p in again.problems)
+
+
+def copy_package(folder: Path) -> Path:
+    """The checkout's ``chain`` package copied into ``folder`` (no caches); its folder."""
+    shutil.copytree(PACKAGE, folder / "chain", ignore=shutil.ignore_patterns("__pycache__"))
+    return folder / "chain"
+
+
+def test_the_check_code_digest_follows_the_check_code(tmp_path):
+    """The digest covers the files the check runs (a copy of the package gives the same
+    one), changes with any of them, and not with a file the check does not run."""
+    assert {"dataset_check.py", "shot_files.py", "metadata.py"} <= {
+        path.name for path in module_sources(CHECK_MODULE, PACKAGE)
+    }
+    copy_ = copy_package(tmp_path)
+    assert check_code_digest(copy_) == check_code_digest()
+    kernels = copy_ / "physics" / "kernels.py"
+    kernels.write_text(kernels.read_text() + "# not the check's code\n")
+    assert check_code_digest(copy_) == check_code_digest()
+    shot_files = copy_ / "apparatus" / "shot_files.py"
+    shot_files.write_text(shot_files.read_text() + "# the check's code\n")
+    assert check_code_digest(copy_) != check_code_digest()
+
+
+#: What common.smk runs at DAG time, with the package on PYTHONPATH: the verdict
+#: folder, then the check of one dataset (a ConfigError: exit status 1).
+DAG_CHECK = """
+import sys
+import chain
+from chain.pipeline.plan.datasets import DEFAULT_CACHE, check_experiment_datasets, experiment_parts
+print(chain.__file__, DEFAULT_CACHE, flush=True)
+config = {"experiment": {"source": "measured", "datasets": [sys.argv[1]]}}
+check_experiment_datasets(config, experiment_parts(config))
+"""
+
+
+def test_verdicts_are_kept_by_the_code_that_made_them(dataset, tmp_path):
+    """Unchanged code reuses the verdicts (a planted one is believed); an edit of the
+    check's code starts a new private folder and removes the old one."""
+    package = copy_package(tmp_path / "lib")
+    work = tmp_path / "work"
+    work.mkdir()
+
+    def dag_check_in(work: Path) -> tuple[Path, subprocess.CompletedProcess]:
+        done = subprocess.run(
+            [sys.executable, "-c", DAG_CHECK, str(dataset)],
+            env={**os.environ, "PYTHONPATH": str(package.parent)},
+            cwd=work, stdin=subprocess.DEVNULL, capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        module, folder = done.stdout.split()
+        assert Path(module).parent == package, done.stderr
+        return work / folder, done
+
+    first, done = dag_check_in(work)
+    assert done.returncode == 0, done.stderr
+    assert stat.S_IMODE(first.stat().st_mode) == 0o700
+    entries = sorted(first.rglob("*.json"))
+    assert len(entries) == 6
+    for entry in entries:
+        entry.write_text(json.dumps({"problems": ["planted verdict"], "faults": []}))
+    again, done = dag_check_in(work)
+    assert again == first and done.returncode == 1 and "planted verdict" in done.stderr
+    check = package / "apparatus" / "dataset_check.py"
+    check.write_text(check.read_text() + "# edited\n")
+    edited, done = dag_check_in(work)
+    assert done.returncode == 0, done.stderr
+    assert edited != first and not first.exists()
+    assert len(sorted(edited.rglob("*.json"))) == 6
 
 
 def test_skipped_shot_is_left_out_and_listed(dataset, tmp_path):

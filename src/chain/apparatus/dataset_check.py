@@ -3,9 +3,11 @@
 :func:`check_dataset` reads ``metadata.yaml`` (:mod:`chain.apparatus.metadata`) and every
 shot file (:mod:`chain.apparatus.shot_files`) and returns every problem found, one line
 each, plus the dead or saturated channels of each shot. The verdict on one shot file
-depends only on its bytes and on the rules it is held to (sensor beads, sampling
-interval, sample count, ADC limits), so it is cached under a hash of both: a thousand
-unchanged shots are re-checked by hashing them, in a fraction of a second.
+depends only on its bytes, on the rules it is held to (sensor beads, sampling
+interval, sample count, ADC limits) and on this code, so it is cached under a hash of
+the first two in a folder for this code (the pipeline names its folder by a digest of
+the code, :data:`chain.pipeline.plan.datasets.DEFAULT_CACHE`): a thousand unchanged
+shots are re-checked by hashing them, in a fraction of a second.
 """
 
 from __future__ import annotations
@@ -27,9 +29,6 @@ from chain.apparatus.measured_format import (
 from chain.apparatus.metadata import DatasetMetadata, read_metadata
 from chain.apparatus.shot_files import channel_faults, saturation_limits, shot_file_problems
 from chain.atomic import write_text_atomic
-
-#: Part of every cache key: bump it when the rules of the check change.
-CHECK_VERSION = "hertzchain-shot-check/1"
 
 #: Stands for the file's path in cached messages (a copied file is the same verdict).
 _FILE = "\x00file\x00"
@@ -73,7 +72,6 @@ def _rules(meta: DatasetMetadata) -> str:
     """What a shot file is held to, as text (part of the cache key)."""
     return json.dumps(
         {
-            "version": CHECK_VERSION,
             "sensor_beads": list(meta.sensor_beads),
             "sampling_interval_s": meta.sampling_interval_s,
             "samples": meta.samples,
@@ -112,7 +110,7 @@ def _cached_check(path: Path, meta: DatasetMetadata, rules: str, cache: Path | N
         pass  # not cached yet, or an unreadable entry: check again
     result, data = _check_file(path, meta, limit)
     generic = {kind: [m.replace(name, _FILE) for m in result[kind]] for kind in result}
-    entry.parent.mkdir(parents=True, exist_ok=True)
+    entry.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
     write_text_atomic(json.dumps(generic), entry)
     return result, data
 
@@ -131,7 +129,9 @@ def check_dataset(
     folder : path
         Dataset folder (``data/README.md`` format).
     cache_dir : path, optional
-        Folder of the verdict cache (created if needed); None checks every file.
+        Folder of the verdict cache, made private (0700) if missing; one folder per
+        version of this code (its verdicts are not keyed by the code). None checks
+        every file.
     limit : int
         Stop after this many problems (the dataset is bad either way).
     keep_data : bool
@@ -152,6 +152,8 @@ def check_dataset(
     meta = read_metadata(folder)
     rules = _rules(meta)
     cache = None if cache_dir is None else Path(cache_dir)
+    if cache is not None:
+        cache.mkdir(mode=0o700, parents=True, exist_ok=True)
     problems: list[str] = []
     faults: dict[int, tuple[str, ...]] = {}
     kept: dict[int, np.ndarray] = {}

@@ -35,8 +35,11 @@ import math
 import numba
 import numpy as np
 
-from chain.physics import compile_once, kernel_cache
+from chain.physics import compile_once, kernel_cache, safe_cache
 from chain.physics.slopes import _hertz_force, _slopes, _wall_energy, _wall_terms
+
+#: numba's cache only in a folder no other account can write (chain.physics.safe_cache).
+CACHE = safe_cache.allowed(__file__)
 
 #: Status codes written by the kernels.
 _OK = 0
@@ -56,7 +59,7 @@ EVENT_AFTERMATH = 3
 QUIET_MARGIN = 4 * EVENT_SUBSTEPS + 4
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _copy_into(target, source):
     # Element by element: numba compiles ``target[:] = source`` through its general
     # slice-assignment code, which made a cold compile several seconds longer.
@@ -64,7 +67,7 @@ def _copy_into(target, source):
         target[p] = source[p]
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _all_finite(values):
     for p in range(values.shape[0]):
         if not math.isfinite(values[p]):
@@ -72,7 +75,7 @@ def _all_finite(values):
     return True
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _rk4(u, v, acc0, slope0, dt, buffers, force, im, k, c, keys, springs, walls, drag):
     """One RK4 step from (u, v), whose slopes ``acc0`` and ``slope0`` (power, closed,
     fingerprint) are known, into (u_out, v_out), the last two ``buffers``.
@@ -112,7 +115,7 @@ def _rk4(u, v, acc0, slope0, dt, buffers, force, im, k, c, keys, springs, walls,
     return sixth * power_sum, varied
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _record(u, v, dissipated, model, links, particles, sample, outputs):
     """Writes sample ``sample``; returns False when the state is not finite.
     ``model`` = (masses, k, c, keys, walls, kind); ``links`` = (link indices, their
@@ -148,7 +151,7 @@ def _record(u, v, dissipated, model, links, particles, sample, outputs):
     return finite
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _potential_energy(u, k, kind, walls):
     n = u.shape[0]
     energy = 0.0
@@ -161,7 +164,7 @@ def _potential_energy(u, k, kind, walls):
     return _wall_energy(u, walls, energy)
 
 
-@numba.njit(cache=True, forceinline=True)
+@numba.njit(cache=CACHE, forceinline=True)
 def _plain_step(
     x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt, im, k, c, keys, springs, walls, drag
 ):
@@ -204,7 +207,7 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, ou
     return status, step, refined
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _reached(u, v, gap, spread):
     """Whether a step that spread a disturbance by ``spread`` beads or fewer brought it
     into the QUIET_MARGIN beads at rest on either side of bead ``gap`` (see
@@ -219,7 +222,7 @@ def _reached(u, v, gap, spread):
     return False
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status):
     """The state reached (in y or in x) into (u, v); returns the status, set to
     _NOT_FINITE if it was _OK and the state is not finite."""
@@ -233,7 +236,7 @@ def _hand_back(in_y, x_u, x_v, y_u, y_v, u, v, status):
     return status
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _work_buffers(n):
     """Five RK4 buffers and the link forces."""
     return (
@@ -242,7 +245,7 @@ def _work_buffers(n):
 
 
 @compile_once.shared
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=CACHE, nogil=True)
 def _integrate_part(
     u, v, params, dt, step, n_steps, record_every, links, particles, outputs,
     refine, refined, dissipated, gap,

@@ -15,11 +15,14 @@ import math
 import numba
 import numpy as np
 
-from chain.physics import compile_once, kernel_cache
+from chain.physics import compile_once, kernel_cache, safe_cache
 from chain.physics.kernels import _NOT_FINITE, _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
 
+#: numba's cache only in a folder no other account can write (chain.physics.safe_cache).
+CACHE = safe_cache.allowed(__file__)
 
-@numba.njit(cache=True, inline="always")
+
+@numba.njit(cache=CACHE, inline="always")
 def _hertz_force(stiffness, damping, delta, delta_rate):
     # Returns (elastic, total); total is clipped at zero because a contact never pulls.
     if delta <= 0.0:
@@ -34,7 +37,7 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
     return elastic, total
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _derivatives(u, v, params, acc, link_force):
     """Accelerations into ``acc``, link forces into ``link_force``; returns
     (left wall force, right wall force, dissipated power, closed Hertz contacts)."""
@@ -84,7 +87,7 @@ def _derivatives(u, v, params, acc, link_force):
     return left, right, power, closed
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _potential_energy(u, params):
     link_kind, link_stiffness, wall_stiffness = params[2], params[3], params[5]
     n = u.shape[0]
@@ -104,7 +107,7 @@ def _potential_energy(u, params):
     return energy
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _record(u, v, dissipated, params, acc, link_force, sample, outputs):
     out_link_force, out_wall_force, out_velocity, out_energy, out_momentum = outputs
     masses = params[0]
@@ -125,7 +128,7 @@ def _record(u, v, dissipated, params, acc, link_force, sample, outputs):
     out_momentum[sample] = momentum
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _rk4_step(u, v, dt, params, work):
     """One classical RK4 step of (u, v) in place; returns the dissipated energy and
     whether the number of closed contacts varied between the stages (a contact event
@@ -164,7 +167,7 @@ def _rk4_step(u, v, dt, params, work):
     return sixth * power_sum, varied
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _contact_changed(u_before, u_after, params):
     """True when a Hertz contact (or wall) opened or closed between two states."""
     link_kind, wall_stiffness = params[2], params[5]
@@ -180,7 +183,7 @@ def _contact_changed(u_before, u_after, params):
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _integrate_one(u, v, params, dt, n_steps, record_every, outputs):
     """RK4 for one launch; ``u`` and ``v`` are updated in place. Returns the status,
     the step at which it was set, and the number of steps refined at contact events."""
@@ -234,7 +237,7 @@ def _integrate_one(u, v, params, dt, n_steps, record_every, outputs):
 
 
 @compile_once.shared
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=CACHE, parallel=True)
 def _integrate_batch(
     u,
     v,

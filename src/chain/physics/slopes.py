@@ -17,8 +17,13 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
+from chain.physics import safe_cache
 
-@numba.njit(cache=True, inline="always")
+#: numba's cache only in a folder no other account can write (chain.physics.safe_cache).
+CACHE = safe_cache.allowed(__file__)
+
+
+@numba.njit(cache=CACHE, inline="always")
 def _hertz_force(stiffness, damping, delta, delta_rate):
     # Returns (elastic, total); total is clipped at zero because a contact never pulls.
     if delta <= 0.0:
@@ -48,7 +53,7 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
 # written in its overload (which LLVM inlines); the kernels without them are as before.
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _walls(u_first, v_first, u_last, v_last, key_left, key_right, walls):
     """(left force N, right force N, dissipated power W, fingerprint) of the walls, from
     the end beads' displacements (m) and velocities (m/s) and the fingerprint keys of
@@ -121,7 +126,7 @@ def _wall_energy_overload(u, walls, energy):
     return lambda u, walls, energy: _walls_energy(u[0], u[u.shape[0] - 1], walls, energy)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=CACHE, inline="always")
 def _slopes(u, v, acc, force, im, k, c, keys, springs, walls, drag):
     """Accelerations into ``acc``; returns (dissipated power, closed contacts, fingerprint).
 
@@ -164,7 +169,7 @@ def _link_terms_overload(
     )
 
 
-@numba.njit(cache=True, forceinline=True)
+@numba.njit(cache=CACHE, forceinline=True)
 def _elastic_links(u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark):
     # In passes, so that the first has no branch and vectorises (SIMD: several links per
     # instruction): every link as a Hertz contact (an open one, delta <= 0, gives
@@ -198,7 +203,7 @@ def _elastic_links(u, v, acc, force, im, k, c, keys, springs, left, right, power
     return power, closed, mark
 
 
-@numba.njit(cache=True, forceinline=True)
+@numba.njit(cache=CACHE, forceinline=True)
 def _damped_links(u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark):
     n = u.shape[0]
     previous = left
@@ -223,7 +228,7 @@ def _damped_links(u, v, acc, force, im, k, c, keys, springs, left, right, power,
     return power, closed, mark
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=CACHE)
 def _walls_energy(u_first, u_last, walls, energy):
     """``energy`` (J) plus the elastic energy of the wall contacts, from the end beads'
     displacements, m."""

@@ -182,6 +182,26 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
     return sorted(os.path.relpath(path, here) for path in files)
 
 
+def module_sources(module: str, package_dir: str | os.PathLike) -> list[Path]:
+    """The package files that importing a module of the package runs: its own file,
+    the ``__init__`` files of the packages it is in, and what they import, transitively.
+
+    Parameters
+    ----------
+    module : str
+        Dotted name (``chain.apparatus.dataset_check``).
+    package_dir : path
+        The ``chain`` package folder (``src/chain``).
+
+    Returns
+    -------
+    list of Path
+        Absolute paths, sorted.
+    """
+    root = Path(package_dir).resolve()
+    return sorted(set().union(*(_package_closure(root, f) for f in _targets(root, module, []))))
+
+
 def script_modules(script: str | os.PathLike, package_dir: str | os.PathLike) -> dict:
     """The package modules a workflow script runs (as :func:`script_sources` follows
     them), each with the top-level packages it imports anywhere in its file.

@@ -13,12 +13,18 @@ what was expected. Shots with a dead or saturated channel stop the run too, unle
 ``experiment.bad_channels: skip``; then :func:`skipped_shot_rows` gives the rows that
 ``experiment/selection.csv`` lists them with (kept False, the channel as the reason),
 so the summary counts them among the rejected shots.
+
+The check's verdicts are kept in :data:`DEFAULT_CACHE`, a folder named by a digest of
+the code that makes them (:func:`check_code_digest`): an edit of that code starts an
+empty folder, and the check's code needs no version to bump.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import re
+import shutil
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,9 +37,32 @@ from chain.apparatus.measured import MeasuredDataError, read_metadata, usable_sh
 from chain.errors import ConfigError
 from chain.errors import key_label as key_name
 from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
+from chain.pipeline.plan.code import module_sources
 
-#: Where the pipeline keeps the verdicts of the dataset check (by file content).
-DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / "dataset-check"
+#: The module whose verdicts are cached, and the package it is in.
+CHECK_MODULE = "chain.apparatus.dataset_check"
+PACKAGE_DIR = Path(__file__).resolve().parents[2]
+
+
+def check_code_digest(package_dir: str | os.PathLike = PACKAGE_DIR) -> str:
+    """SHA-256 (hex) of the code of the dataset check: every file of the package that
+    importing :data:`CHECK_MODULE` runs, each with its path in the package.
+
+    Parameters
+    ----------
+    package_dir : path
+        The ``chain`` package folder (by default this one's).
+    """
+    digest = hashlib.sha256()
+    for path in module_sources(CHECK_MODULE, package_dir):
+        name = path.relative_to(Path(package_dir).resolve()).as_posix()
+        digest.update(name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+#: Where the pipeline keeps the verdicts of the dataset check (by file content), one
+#: folder per version of the check's code.
+DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / f"dataset-check-{check_code_digest()[:16]}"
 
 #: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
 SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
@@ -188,7 +217,9 @@ def check_experiment_datasets(
     root : path
         Folder that relative dataset paths start from.
     cache_dir : path or None
-        Verdict cache (relative paths start from ``root``); None checks every file.
+        Verdict cache (relative paths start from ``root``), made private (0700); the
+        folders beside it named ``dataset-check*`` (verdicts of other versions of the
+        check's code) are removed. None checks every file.
 
     Raises
     ------
@@ -197,6 +228,9 @@ def check_experiment_datasets(
     """
     policy = bad_channel_policy(config)
     cache = None if cache_dir is None else Path(root) / cache_dir
+    for old in [] if cache is None else cache.parent.glob("dataset-check*"):
+        if old != cache and old.is_dir():
+            shutil.rmtree(old, ignore_errors=True)
     messages, bad = [], 0
     for part in parts:
         if part.folder is None:
