@@ -199,3 +199,21 @@ def test_a_link_in_the_run_folder_is_never_taken_for_a_result(work, tmp_path):
     Reuse(p, work).prepare(p.targets)
     assert not Path(p.out, "b.csv").is_symlink()
     assert Path(p.out, "b.csv").read_text() == "z\n3\n"
+
+
+def test_hertzchain_check_explains_what_sha256sum_rejects(work):
+    """No SHA256SUMS (a failed or interrupted run), a file changed since, a file added
+    after: each named, in words."""
+    from chain.pipeline.run.checksums import checksum_problems
+
+    first_run(work)
+    out = Path("results/first")
+    assert checksum_problems(out) == []
+    Path(out, "b.csv").write_text("z\n4\n")
+    Path(out, "extra.csv").write_text("x\n")
+    problems = checksum_problems(out)
+    assert any("b.csv: changed since the run certified it" in p for p in problems)
+    assert any("extra.csv: not certified" in p for p in problems)
+    Path(out, CHECKSUMS).unlink()
+    (missing,) = checksum_problems(out)
+    assert "did not complete" in missing

@@ -202,7 +202,8 @@ def _add_check(commands) -> None:
     check = commands.add_parser(
         "check",
         help="check a run against the results contract and a reference",
-        description="Check results/<run_name>: contract files and columns, and the headline "
+        description="Check results/<run_name>: contract files and columns, its SHA256SUMS "
+        "(written only by a run that succeeded), and the headline "
         "numbers of summary.json against a reference file within its tolerances. "
         "Exit status 1 lists every failure. Packages the run had at other versions than "
         "the lock (requirements/py3XX.lock) are named in a warning.",
@@ -247,6 +248,7 @@ def _check(args: argparse.Namespace) -> int:
 
     from chain.pipeline.provenance import headline
     from chain.pipeline.provenance.record import lock_warnings
+    from chain.pipeline.run.checksums import checksum_problems
 
     folder = Path(args.run_folder)
     summary_path = folder / "summary.json"
@@ -261,6 +263,7 @@ def _check(args: argparse.Namespace) -> int:
         return 0
     reference = json.loads(Path(args.reference).read_text())
     failures = headline.missing_contract_files(folder, experiment=not args.no_experiment)
+    failures += checksum_problems(folder)
     failures += headline.compare_with_reference(headline.headline_numbers(summary), reference)
     for failure in failures:
         print(f"FAIL {failure}")

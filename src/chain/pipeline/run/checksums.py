@@ -58,3 +58,30 @@ def write_checksums(folder: str | os.PathLike, digests: Mapping[str, str] = {}) 
 def remove_checksums(folder: str | os.PathLike) -> None:
     """Remove ``<folder>/SHA256SUMS``: the folder no longer holds a complete run."""
     (Path(folder) / CHECKSUMS).unlink(missing_ok=True)
+
+
+def checksum_problems(folder: str | os.PathLike) -> list[str]:
+    """What ``sha256sum -c SHA256SUMS`` would reject in a run folder, in words: no
+    checksums (the last run there failed or was interrupted), or a listed file missing
+    or changed since the run certified it, or a file the run did not certify.
+
+    Parameters
+    ----------
+    folder : path
+        A run folder (``results/<run_name>``).
+    """
+    sums = Path(folder) / CHECKSUMS
+    if not sums.is_file():
+        return [f"{sums}: missing: the last run in this folder did not complete (a failed "
+                "or interrupted run leaves none); run the pipeline again"]  # fmt: skip
+    listed = dict(reversed(line.split("  ", 1)) for line in sums.read_text().splitlines())
+    problems = []
+    for name in sorted(set(listed) | set(run_files(folder))):
+        path = Path(folder) / name
+        if name not in listed:
+            problems.append(f"{path}: not certified by {CHECKSUMS} (written after the run)")
+        elif not path.is_file():
+            problems.append(f"{path}: listed in {CHECKSUMS}, missing")
+        elif file_digest(path) != listed[name]:
+            problems.append(f"{path}: changed since the run certified it ({CHECKSUMS})")
+    return problems

@@ -87,7 +87,9 @@ class Reuse:
                 "rule": job.rule,
                 "wildcards": job.wildcards,
                 "params": job.params,
-                "inputs": {n: [self._token(p) for p in as_list(ps)] for n, ps in job.inputs.items()},
+                "inputs": {
+                    n: [self._token(p) for p in as_list(ps)] for n, ps in job.inputs.items()
+                },
                 "outputs": {n: os.path.relpath(p, self.plan.out) for n, p in job.outputs.items()},
                 "software": self._software,
             }
