@@ -217,3 +217,16 @@ def test_hertzchain_check_explains_what_sha256sum_rejects(work):
     Path(out, CHECKSUMS).unlink()
     (missing,) = checksum_problems(out)
     assert "did not complete" in missing
+
+
+def test_what_a_killed_run_computed_is_stored_by_the_next_run_in_its_folder(work):
+    """A run killed before its end stores nothing; the next run in the same folder finds
+    the outputs it wrote and stores those whose recipe is still the same."""
+    p = plan("first")
+    Reuse(p, work).prepare(p.targets)
+    compute(p, which=("make",))  # then the run is killed: no finish
+    reuse = Reuse(p, work)
+    _, stored = reuse.prepare(p.targets)
+    assert "make: computed by an interrupted run: stored" in stored
+    other = plan("second")
+    assert "1 of 2 jobs take a stored result" in Reuse(other, work).prepare(other.targets)[0]

@@ -28,6 +28,7 @@ import os
 import time
 from pathlib import Path
 
+from chain.atomic import write_text_atomic
 from chain.pipeline.plan.steps import Job, as_list
 from chain.pipeline.provenance.record import PACKAGES, package_versions
 from chain.pipeline.run.checksums import write_checksums
@@ -129,9 +130,11 @@ class Reuse:
         self.prepared = True
         self.started_at = time.time()
         if self.store is None or forced:
+            if forced and not dry:
+                self._note_pending(self.needed)
             why = "off (reuse: false)" if self.store is None else "forced, results replace"
             return [f"hertzchain store: {why}: the run's {len(self.needed)} jobs compute"]
-        settled, lines, present = set(), [], 0
+        settled, lines, present, pending = set(), [], 0, self._pending()
         for job in self.needed:
             outputs = list(job.outputs.values())
             for path in outputs:  # a link is never taken for a result
@@ -140,8 +143,12 @@ class Reuse:
             if all(os.path.exists(p) for p in outputs):
                 settled.add(id(job))
                 present += 1
+                if not dry and pending.get(str(job)) == self.key(job):
+                    lines += self._put(job, "computed by an interrupted run: stored")
             elif self._upstream_settled(job, settled) and self._take(job, dry, lines):
                 settled.add(id(job))
+        if not dry:
+            self._note_pending([j for j in self.needed if id(j) not in settled])
         verb = "would take" if dry else "take"
         computing = len(self.needed) - present - len(self.reused)
         tally = (
@@ -154,6 +161,25 @@ class Reuse:
             # none of its hooks. Otherwise the run's end writes them (onstart removes).
             write_checksums(self.plan.out, self.digests)
         return [tally, *lines]
+
+    @property
+    def _pending_file(self) -> Path:
+        return Path(".snakemake", "hertzchain", f"pending-{self.plan.run_name}.json")
+
+    def _pending(self) -> dict[str, str]:
+        """Job -> key of the jobs an earlier run in this folder set out to compute and
+        did not store (it was killed before its end)."""
+        try:
+            return json.loads(self._pending_file.read_text())
+        except (OSError, ValueError):
+            return {}
+
+    def _note_pending(self, jobs: list[Job]) -> None:
+        """Write down the jobs this run will compute, with their keys: if the run is
+        killed before it stores them, the next run in this folder stores those whose
+        outputs are there and whose recipe is the same."""
+        self._pending_file.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(json.dumps({str(j): self.key(j) for j in jobs}), self._pending_file)
 
     def _upstream_settled(self, job: Job, settled: set) -> bool:
         """Whether every job that ``job`` reads from is done before the run starts (a
@@ -215,6 +241,8 @@ class Reuse:
                          f"{len(computed)} computed and stored")  # fmt: skip
         if succeeded:
             write_checksums(self.plan.out, self.digests)
+        if self.store is not None:
+            self._pending_file.unlink(missing_ok=True)
         return lines
 
     def _made_now(self, job: Job) -> bool:
@@ -224,12 +252,15 @@ class Reuse:
             return False
         return min(times) >= self.started_at - 1.0
 
-    def _put(self, job: Job) -> list[str]:
-        """Store one computed job; the console's lines about it."""
+    def _put(self, job: Job, said: str = "") -> list[str]:
+        """Store one computed job; the console's lines about it (with ``said``, one that
+        says so)."""
         outputs = list(job.outputs.values())
         if self.store is None:
             return []
         key = self.key(job)
+        if said and self.store.recorded(key) is not None:
+            return []
         before = self.store.recorded(key) if self.forced else None
         about = {"job": str(job), "run": self.plan.run_name,
                  "paths": [os.path.relpath(p, self.plan.out) for p in outputs],
@@ -242,4 +273,4 @@ class Reuse:
         self.digests |= output_digests(outputs, manifest)
         if before is not None and before["outputs"] != manifest["outputs"]:
             return [f"  {job}: recomputed bytes differ from the stored ones (replaced)"]
-        return []
+        return [f"  {job}: {said}"] if said else []
