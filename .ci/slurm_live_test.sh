@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Live SLURM test (issues 16, 32): start a one-node SLURM cluster on this machine, run the
+# Live SLURM test: start a one-node SLURM cluster on this machine, run the
 # tiny test config through the SLURM profile (profiles/slurm) with two faults a cluster
 # user meets, and compare the results byte for byte with a local run of the same config.
 #
@@ -32,8 +32,9 @@
 #
 # Needs the project installed with the extra: pip install -e ".[test,slurm]".
 #   3. Reuse on the cluster: the same config under a second run name takes every result
-#      but the run's own summary and article from the store the first run's jobs filled,
-#      computes no simulation, and gives the same bytes.
+#      but the run's own summary and article from the store the first runs filled, before
+#      its first job: it submits exactly as many sbatch jobs as jobs that compute (counted
+#      by sacct from SLURM's job completion log), and gives the same bytes.
 # HERTZCHAIN_SLURM_KEEP=1 keeps the folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -216,7 +217,9 @@ ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
-JobCompType=jobcomp/none
+# A job completion log, which \`sacct --completion\` reads (no accounting database here).
+JobCompType=jobcomp/filetxt
+JobCompLoc=$WORK/jobcomp.txt
 SchedulerType=sched/backfill
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core_Memory
@@ -431,27 +434,33 @@ COUNT=$(cd "$WORK/slurm/results/$RUN" && find . -type f -not -path './logs/*' \
 say "results/$RUN identical to the local run, byte for byte ($COUNT files; logs/ and benchmarks/ excluded)"
 
 # ---- reuse on the cluster: a second run name takes what the first computed ----------
-# The jobs of runs 1 and 2 stored their results (results/.store, on the file system the
-# nodes share); the same config under another name runs no simulation: every job but
-# those stating the run (summary, summary_md, article) takes its stored result.
+# Runs 1 and 2 stored their results (results/.store, on the file system the nodes share);
+# the same config under another name takes them into its run folder before its first job,
+# on the login node, and submits only the jobs stating the run (summary, summary_md,
+# article): sacct counts its sbatch jobs.
 AGAIN=${RUN}_again
 start=$SECONDS
 run_snakemake 1800 "$WORK/slurm-run-3.log" --config "run_name=$AGAIN"
 [[ $STATUS -eq 0 ]] || fail "SLURM run 3 (run_name $AGAIN) failed (status $STATUS)"
 FORECAST=$(grep -o '[0-9]* of [0-9]* jobs take a stored result, [0-9]* compute' \
     "$WORK/slurm-run-3.log" | head -n 1)
-[[ $FORECAST == *", 3 compute" ]] || fail "run 3's forecast: '${FORECAST:-none}', not 3 jobs to compute"
-TALLY=$(grep -o 'hertzchain store: [0-9]* results reused, [0-9]* computed' "$WORK/slurm-run-3.log")
-[[ $TALLY == *", 3 computed" ]] || fail "run 3's jobs: '${TALLY:-no tally}', not 3 computed"
+COMPUTE=$(sed -n 's/.* \([0-9]*\) compute$/\1/p' <<<"$FORECAST")
+[[ $COMPUTE -eq 3 ]] || fail "run 3's first line: '${FORECAST:-none}', not 3 jobs to compute"
+RUN3=$(run_id "$WORK/slurm-run-3.log")
+SUBMITTED=$(sacct --completion -n -P -o JobName,JobID | awk -F'|' -v run="$RUN3" \
+    '$1 == run' | wc -l)
+say "run 3: sacct counts $SUBMITTED sbatch jobs (SLURM run ID $RUN3); $COMPUTE jobs compute"
+[[ $SUBMITTED -eq $COMPUTE ]] || fail "run 3 submitted $SUBMITTED sbatch jobs, $COMPUTE compute"
 AGAIN_DIR=$WORK/slurm/results/$AGAIN
 for log in "$AGAIN_DIR"/logs/simulate/*.log "$AGAIN_DIR"/logs/experiment/virtual_*.log; do
-    grep -q '^reused from the store: ' "$log" || fail "run 3 computed ${log#"$AGAIN_DIR"/}"
+    grep -q '^taken from the store: ' "$log" || fail "run 3 computed ${log#"$AGAIN_DIR"/}"
 done
 compare "$WORK/slurm/results/$RUN" "$AGAIN_DIR" --exclude=summary.json \
     --exclude=summary.md --exclude=article.pdf ||
     fail "run 3's results differ from those it reused"
 (cd "$AGAIN_DIR" && sha256sum -c --quiet SHA256SUMS) || fail "run 3's SHA256SUMS does not check"
 [[ -z $(find "$AGAIN_DIR" -type l) ]] || fail "run 3's folder holds links"
-say "SLURM run 3 (run_name $AGAIN): $FORECAST; $TALLY; no simulation computed;" \
-    "results identical to run 2's, plain files, SHA256SUMS checks ($((SECONDS - start)) s)"
+say "SLURM run 3 (run_name $AGAIN): $FORECAST; $SUBMITTED sbatch jobs; no simulation" \
+    "computed; results identical to run 2's, plain files, SHA256SUMS checks" \
+    "($((SECONDS - start)) s)"
 say "PASSED"

@@ -75,7 +75,11 @@ def prepare_run():
     workflow (not a cluster job's, not a report's): called by the first input function
     Snakemake evaluates, as it builds the DAG of a run or a dry run."""
     global STORE
-    if REUSE.prepared or not workflow.is_main_process or workflow.executor_plugin is None:
+    if (
+        REUSE.prepared
+        or not workflow.is_main_process
+        or workflow.executor_plugin is None
+    ):
         return
     if workflow.touch:
         return
@@ -110,6 +114,49 @@ def target_inputs(rule):
         return REUSE.located(PLAN.target_rules()[rule])
 
     return inputs
+
+
+# ---- the rules of the plan's steps (steps.smk) ----------------------------------------
+
+
+def caption(name):
+    """A report caption: workflow/report/<name>, or the generic figure caption."""
+    own = Path(workflow.basedir, "workflow", "report", name)
+    return f"../report/{name if own.exists() else 'figure.rst'}"
+
+
+def step_outputs(step):
+    """(positional, named) outputs of a step, flagged for the report or as folders."""
+    flagged = {}
+    for name, path in step.outputs.items():
+        if name in step.folders:
+            path = directory(path)
+        if name in step.report:
+            file, category = step.report[name]
+            path = report(path, caption=caption(file), category=category)
+        flagged[name] = path
+    positional = [p for n, p in flagged.items() if not n.isidentifier()]
+    return positional, {n: p for n, p in flagged.items() if n.isidentifier()}
+
+
+def step_params(step):
+    """Parameter name -> function of the wildcards, for each parameter of the step; and
+    the script's name, which names the script file when the job runs (Snakemake reads
+    the script directive again then, long after this loop has moved on)."""
+    names = PLAN.jobs.of(step.name, step.jobs[0]).params
+    params = {
+        name: lambda wildcards, n=name, s=step.name: PLAN.jobs.of(s, wildcards).params[
+            n
+        ]
+        for name in names
+    }
+    return {**params, "script": step.script_name}
+
+
+def step_benchmark(step):
+    """Snakemake's record of the job's time and memory, beside its log's place."""
+    log = os.path.relpath(step.log, f"{OUT}/logs")
+    return f"{OUT}/benchmarks/{os.path.splitext(log)[0]}.tsv"
 
 
 onstart:
