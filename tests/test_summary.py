@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain.analysis.selection import SKIPPED_REASON
+from chain.labels import SKIPPED_REASON
 from chain.physics.theory import ballistic_constants as run_constants
 from chain.report.numbers.paper import PAPER
 from chain.report.numbers.summary import build_summary, summary_json, write_summary_json

@@ -9,3 +9,7 @@ VIRTUAL_SERIES = "virtual"
 
 #: Label of the virtual experiment's rows in figures and summary (not data).
 VIRTUAL_LABEL = "virtual experiment (model)"
+
+#: Reason given in experiment/selection.csv for a shot left out because a channel is
+#: dead or saturated (``experiment.bad_channels: skip``).
+SKIPPED_REASON = "skipped (experiment.bad_channels: skip)"

@@ -23,13 +23,10 @@ import pandas as pd
 
 from chain.analysis.rows import is_ok
 from chain.errors import ParameterError
+from chain.labels import SKIPPED_REASON
 
 #: The paper's amplitude-match tolerance (5 %).
 DEFAULT_TOLERANCE = 0.05
-
-#: Start of the reason of a shot left out before the analysis for a dead or saturated
-#: channel (``experiment.bad_channels: skip``; chain.pipeline.plan.datasets writes the rows).
-SKIPPED_REASON = "skipped (experiment.bad_channels: skip)"
 
 #: Columns of the selection table, in order.
 SELECTION_COLUMNS = (

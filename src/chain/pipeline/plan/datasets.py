@@ -31,12 +31,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from chain.analysis.selection import SELECTION_COLUMNS, SKIPPED_REASON
+from chain.analysis.selection import SELECTION_COLUMNS
 from chain.apparatus.dataset_check import DatasetCheck, check_dataset
 from chain.apparatus.measured import MeasuredDataError, read_metadata, usable_shots
 from chain.errors import ConfigError
 from chain.errors import key_label as key_name
-from chain.labels import VIRTUAL_LABEL, VIRTUAL_SERIES
+from chain.labels import SKIPPED_REASON, VIRTUAL_LABEL, VIRTUAL_SERIES
 from chain.pipeline.plan.code import module_sources
 
 #: The module whose verdicts are cached, and the package it is in.

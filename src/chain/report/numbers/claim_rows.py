@@ -4,6 +4,8 @@ against, the row of a claim and its verdict, and the delay-fit rows a claim read
 
 from __future__ import annotations
 
+from chain.report.printed import number
+
 #: When a number of ours "agrees" with the paper's claim. Relative for C, absolute for
 #: exponents; printed in the article beside the table.
 TOLERANCES = {
@@ -59,3 +61,18 @@ def claim_row(claim, paper, ours, ok, why="") -> dict:
     """A row of the claim table: the claim, the paper's number or statement, ours, the
     verdict of ``ok`` (:func:`verdict`) and why it does not agree."""
     return {"claim": claim, "paper": paper, "ours": ours, "agrees": verdict(ok), "why": why}
+
+
+def loss_text(summary, model) -> str | None:
+    """'a lone wave loses 4.0 % (at 9.5 N) to 8.0 % (at 927 N) between the sensors'."""
+    rows = [r for r in summary.get("attenuation") or [] if r["model"] == model]
+    if not rows:
+        return None
+    row = max(rows, key=lambda r: 1 - r["ratio_high"])
+    return (
+        f"a lone wave loses {100 * (1 - row['ratio_low']):.1f} % (at "
+        f"{number(row['F_S1_low_N'], 3)} N) to {100 * (1 - row['ratio_high']):.1f} % (at "
+        f"{number(row['F_S1_high_N'], 3)} N) of its "
+        f"amplitude between S1 and S2 (N = {row['N']}), so the waves cross weaker than the "
+        "F_m measured at S1, by a fraction that grows with F_m"
+    )

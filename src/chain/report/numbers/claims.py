@@ -25,27 +25,13 @@ from chain.report.numbers.claim_rows import (
     TOLERANCES,
     claim_row,
     fit_row,
+    loss_text,
     series_models,
 )
 from chain.report.numbers.mechanisms import friction_c_text
 from chain.report.numbers.paper import PAPER_ENERGY_DRIFT
 from chain.report.numbers.ssw_claims import ssw_claims
-from chain.report.printed import number, percent, plus_minus, power_of_ten
-
-
-def loss_text(summary, model) -> str | None:
-    """'a lone wave loses 4.0 % (at 9.5 N) to 8.0 % (at 927 N) between the sensors'."""
-    rows = [r for r in summary.get("attenuation") or [] if r["model"] == model]
-    if not rows:
-        return None
-    row = max(rows, key=lambda r: 1 - r["ratio_high"])
-    return (
-        f"a lone wave loses {100 * (1 - row['ratio_low']):.1f} % (at "
-        f"{number(row['F_S1_low_N'], 3)} N) to {100 * (1 - row['ratio_high']):.1f} % (at "
-        f"{number(row['F_S1_high_N'], 3)} N) of its "
-        f"amplitude between S1 and S2 (N = {row['N']}), so the waves cross weaker than the "
-        "F_m measured at S1, by a fraction that grows with F_m"
-    )
+from chain.report.printed import percent, plus_minus, power_of_ten
 
 
 def _early_claim(summary, delays: pd.DataFrame | None) -> list[dict]:

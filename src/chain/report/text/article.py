@@ -22,8 +22,7 @@ from pathlib import Path
 
 from chain.atomic import atomic_output
 from chain.report.naming import is_virtual, named
-from chain.report.numbers.claim_rows import NOT_COMPUTED, fit_row, series_models
-from chain.report.numbers.claims import loss_text
+from chain.report.numbers.claim_rows import NOT_COMPUTED, fit_row, loss_text, series_models
 from chain.report.numbers.paper import PAPER_ENERGY_DRIFT
 from chain.report.printed import (
     fixed,

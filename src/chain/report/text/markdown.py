@@ -18,8 +18,8 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-from chain.analysis.selection import SKIPPED_REASON
 from chain.atomic import write_text_atomic
+from chain.labels import SKIPPED_REASON
 from chain.report.naming import is_virtual, named
 from chain.report.numbers.paper import PAPER_ENERGY_DRIFT
 from chain.report.printed import number, percent, plus_minus, power_of_ten
