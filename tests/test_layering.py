@@ -2,7 +2,8 @@
 downhill only, so that physics can be read without tables, the analysis without
 figures, and the report without an integrator.
 
-    pipeline, cli          (config keys, results/, the command line)
+    pipeline, cli          (config keys, results/, the command line); the pipeline in
+                           rooms: config <- plan <- run, provenance beside them
     studies | report       (side by side, no arrow between them)
       studies              -> physics, apparatus, analysis (simulate and analyse in-process)
       report               -> analysis, physics.theory/materials
@@ -115,6 +116,33 @@ def test_no_forbidden_third_party_imports(module):
     top = {name.split(".")[0] for name in imports(MODULES[module])}
     wrong = sorted(top & (FORBIDDEN[wing(module)] | {"snakemake"}))
     assert not wrong, f"{module} ({wing(module)}) imports {wrong}"
+
+
+#: The pipeline's rooms -> the rooms each may import: one way, config <- plan <- run,
+#: provenance beside them (run states the versions of what it stores).
+ROOMS = {
+    "config": set(),
+    "provenance": set(),
+    "plan": {"config"},
+    "run": {"config", "plan", "provenance"},
+}
+
+
+def room(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 and parts[:2] == ["chain", "pipeline"] else None
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if room(m)))
+def test_the_pipelines_rooms_import_one_way(module):
+    assert set(ROOMS) == {p.name for p in (PACKAGE / "pipeline").iterdir() if p.is_dir()
+                          and p.name != "__pycache__"}  # fmt: skip
+    wrong = sorted(
+        name
+        for name in imports(MODULES[module])
+        if room(name) and room(name) != room(module) and room(name) not in ROOMS[room(module)]
+    )
+    assert not wrong, f"{module} ({room(module)}) imports {wrong}: the rooms run one way"
 
 
 def test_the_check_catches_an_uphill_import(tmp_path):
