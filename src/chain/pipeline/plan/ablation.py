@@ -145,3 +145,7 @@ class AblationPlan:
     def full_targets(self) -> list[str]:
         """``tables/ablation_exponent_all.csv`` (the target ``ablation``)."""
         return [f"{self.plan.tables}/ablation_exponent_all.csv"] if self.variants else []
+
+
+#: This study's part of the plan (:attr:`chain.pipeline.plan.run_plan.RunPlan.parts`).
+PART = AblationPlan

