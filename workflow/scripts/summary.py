@@ -28,7 +28,7 @@ summary = build_summary(
     tolerance=p.tolerance if snakemake.input.get("selection") else None,
     ssw_speed=pd.read_csv(snakemake.input.ssw_speed),
 )
-# Issue 13 items 6 and 7: the ablation verdict (with the virtual experiment) and the
+# The ablation verdict (with the virtual experiment) and the
 # spread of C over our choices.
 if snakemake.input.get("ablation"):
     summary["ablation"] = ablation_summary(
@@ -38,7 +38,7 @@ if snakemake.input.get("ablation"):
     )
 if snakemake.input.get("c_sensitivity"):
     summary["c_spread"] = c_spread_summary(pd.read_csv(snakemake.input.c_sensitivity[0]))
-# Issue 24: the mechanism study's verdict (LAMMPS rows only where LAMMPS is installed).
+# The mechanism study's verdict (LAMMPS rows only where LAMMPS is installed).
 if snakemake.input.get("mechanisms"):
     check = snakemake.input.get("lammps_check")
     summary["ssw_mechanisms"] = mechanism_summary(
@@ -54,7 +54,7 @@ if p.studies_not_run:
 summary = with_claims(
     summary, pd.read_csv(snakemake.input.delays), pd.read_csv(snakemake.input.ssw)
 )
-summary["provenance"] = p.provenance  # issue 32: versions, and the lock's
+summary["provenance"] = p.provenance  # versions, and the lock's
 write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])

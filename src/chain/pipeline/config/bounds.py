@@ -1,4 +1,4 @@
-"""Bounds of config values that depend on other keys (issue 32, item 3).
+"""Bounds of config values that depend on other keys.
 
 The JSON schema (``workflow/schemas/config.schema.yaml``) holds every bound of a key on
 its own (``minimum``, ``maxItems``, ...). The bounds here need a second key: a sensor

@@ -1,4 +1,4 @@
-"""Bounds of the virtual experiment that depend on other keys (issue 32, item 3): the
+"""Bounds of the virtual experiment that depend on other keys: the
 digitiser against the narrowest and the smallest pulse, the sensor spring against a
 given time step, the launch delay against the sensors, the selection tolerance against
 the shots' speed mismatch.

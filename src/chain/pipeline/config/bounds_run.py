@@ -1,6 +1,6 @@
 """Bounds of the simulated run that depend on other keys: sensor beads against the
 collision point, record intervals against time steps and the narrowest pulse,
-durations against the slowest wave, LAMMPS file names (issue 32, item 3).
+durations against the slowest wave, LAMMPS file names.
 
 Also the pulse estimates the bounds of :mod:`chain.pipeline.config.bounds_experiment`
 share. A pulse of incident amplitude F_m has the half width tau = R sqrt(10) / v

@@ -1,5 +1,5 @@
 """The table docs/config_bounds.md: every key of the config schema, its unit, smallest
-and largest usable value, and what else bounds it and why (issue 32, item 3).
+and largest usable value, and what else bounds it and why.
 
 The schema's own bounds (``minimum``, ``maxLength``, ``enum``...) fill the value
 columns; :data:`RULES` adds, per key, the bounds that need other keys

@@ -20,8 +20,8 @@ of a run, every input that determines what the job computes (the *job inputs*):
 
 The job's output depends on these values and on the code it runs (the rule's code
 inputs, :mod:`chain.pipeline.plan.code`), on nothing else: no seed (the simulation has no
-randomness) and no analysis or figure key. The dict is JSON-serialisable, so that a
-cache of results (issue 33) can hash it; the workflow passes it to the job as a rule
+randomness) and no analysis or figure key. The dict is JSON-serialisable, so that the
+store's key of the job can hash it; the workflow passes it to the job as a rule
 parameter, and the job builds its chain from it with :func:`chain_of` (the one place a
 config's chain is built) and its :func:`chain.apparatus.shots.simulate_shots` arguments
 with :func:`simulation_kwargs`. This module is kept small on purpose: a script that

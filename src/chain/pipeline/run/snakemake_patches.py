@@ -8,7 +8,7 @@ needs no part of this workflow in ``docs/upstream/`` (``docs/upstream/README.md`
   and every job that starts or ends adds a pass, so the timers multiply. The tiny test
   config's 53 jobs made 1687 passes, each re-reading the size of every ready job's
   inputs and solving the job selection again: 10.3 s of Snakemake's CPU, 4.5 s with
-  one pending wake-up (snakemake issue #3804: with 10 000 jobs it runs out of
+  one pending wake-up (snakemake/snakemake#3804: with 10 000 jobs it runs out of
   threads). The timers are not daemons, so the process also waits up to a second for
   them after its last job.
 * **SIGTERM hangs the run** (:func:`stop_gracefully_off_the_main_thread`). The SIGTERM
