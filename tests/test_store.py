@@ -1,11 +1,12 @@
 """The result store (chain.pipeline.run.store): what a job stored comes back byte for
 byte or not at all; the store's whole path is checked and the store held by
 descriptor; a group store is its group's and no one else's; writes are flushed and a
-killed fetch leaves nothing for long. The store's user: tests/test_reuse.py and
-tests/test_workflow.py."""
+killed fetch leaves nothing for long; ``hertzchain store`` says what it holds and
+prunes it. The store's user: tests/test_reuse.py and tests/test_workflow.py."""
 
 from __future__ import annotations
 
+import datetime
 import grp
 import json
 import os
@@ -21,6 +22,7 @@ from pathlib import Path
 import pytest
 
 from chain import atomic
+from chain.cli import main
 from chain.pipeline.run import store_path
 from chain.pipeline.run.staging import PREFIX, remove_stale_staging
 from chain.pipeline.run.store import (
@@ -547,3 +549,83 @@ def test_only_staging_of_processes_gone_is_stale(tmp_path):
         name for kind, name in names.items() if kind != "dead"
     )
     assert remove_stale_staging(tmp_path / "missing") == []
+
+
+# ---- hertzchain store -------------------------------------------------------------------
+
+
+@pytest.fixture
+def shelf(tmp_path, monkeypatch):
+    """A checkout with a store of three entries: one that the run folder ``paper``
+    shows (stored 2020-01-01), one whose file the run shows with other bytes, one of
+    a run folder without SHA256SUMS. Returns the store and the keys in that order."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv(STORE_VARIABLE, raising=False)
+    store = Store.open({})
+    keys = ["a1" * 32, "b2" * 32, "c3" * 32]
+    for run, key, stored in [("paper", keys[0], "2020-01-01T10:00:00"),
+                             ("paper", keys[1], "2024-06-01T10:00:00"),
+                             ("gone", keys[2], "2024-06-01T10:00:00")]:  # fmt: skip
+        folder = tmp_path / "results" / run
+        (folder / "raw").mkdir(parents=True, exist_ok=True)
+        (folder / "raw" / f"{key[:2]}.csv").write_text(f"{key}\n")
+        (folder / f"{key[:2]}.csv").write_text(f"{key[:2]}\n")
+        paths = [f"{key[:2]}.csv", "raw"]
+        store.put(key, [str(folder / p) for p in paths], {"paths": paths, "stored": stored})
+    (tmp_path / "results" / "paper" / "b2.csv").write_text("changed\n")
+    write_checksums(tmp_path / "results" / "paper")
+    return store, keys
+
+
+def entries_left(store: Store) -> list[str]:
+    return [key for key, _, _ in store.entries()]
+
+
+def test_store_says_where_it_is_how_many_entries_and_their_size(shelf, capsys):
+    store, _ = shelf
+    size = sum(size for _, _, size in store.entries())
+    assert main(["store"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"result store {Path('results') / '.store'}: 3 entries, ")
+    assert f"({size} bytes)" in out or f"{size} B" in out
+
+
+def test_prune_removes_what_no_run_folder_holds(shelf, capsys):
+    """The run folder shows the first entry's every file with its digest: kept; the
+    second's file has other bytes, the third's run folder has no SHA256SUMS: gone."""
+    store, keys = shelf
+    assert main(["store", "prune", "--dry-run"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert entries_left(store) == keys  # nothing removed by a dry run
+    assert [line.split()[0] for line in out[:-1]] == [keys[1][:12], keys[2][:12]]
+    freed = sum(size for key, _, size in store.entries() if key != keys[0])
+    assert out[-1].startswith("would remove 2 entries, freeing ") and str(freed) in out[-1]
+    assert main(["store", "prune"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == out[-1].replace(
+        "would remove 2 entries, freeing", "removed 2 entries, freed"
+    )
+    assert entries_left(store) == keys[:1]
+    assert list((store.root / "tmp").iterdir()) == []
+
+
+def test_prune_older_than_removes_entries_stored_before_the_day_even_held(shelf, capsys):
+    store, keys = shelf
+    assert main(["store", "prune", "--older-than", "2019-12-31"]) == 0
+    assert entries_left(store) == keys[:1]
+    assert main(["store", "prune", "--older-than", "2020-01-02"]) == 0
+    assert "stored 2020-01-01, before 2020-01-02" in capsys.readouterr().out
+    assert entries_left(store) == []
+
+
+def test_store_honours_its_variable_and_creates_nothing(tmp_path, monkeypatch, outputs, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "elsewhere"))
+    assert main(["store"]) == 0 and main(["store", "prune"]) == 0
+    assert capsys.readouterr().out == f"no result store at {tmp_path / 'elsewhere'}\n" * 2
+    assert not (tmp_path / "elsewhere").exists()
+    Store.open(os.environ).put(KEY, outputs, {"stored": datetime.datetime.now().isoformat()})
+    assert main(["store"]) == 0
+    assert capsys.readouterr().out.startswith(f"result store {tmp_path / 'elsewhere'}: 1 entries")
+    os.chmod(tmp_path / "elsewhere", 0o777)
+    assert main(["store"]) == 2
+    assert "writable by others" in capsys.readouterr().err
