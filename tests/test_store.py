@@ -224,6 +224,11 @@ def test_a_store_others_may_write_is_refused(tmp_path):
     os.chmod(folder, 0o770)
     with pytest.raises(StoreError, match=GROUP_VARIABLE):
         Store.open({STORE_VARIABLE: str(folder)})
+    mine = grp.getgrgid(os.getgid()).gr_name  # the user's group: a group store of it
+    os.chmod(folder, 0o777)  # writable by everyone: refused, not made the group's
+    with pytest.raises(StoreError, match="writable by others"):
+        Store.open({STORE_VARIABLE: str(folder), GROUP_VARIABLE: mine})
+    assert stat.S_IMODE(folder.stat().st_mode) == 0o777
     if os.getuid() == 0:  # as root, a folder of uid 65534 can be made
         os.chmod(folder, 0o700)
         os.chown(folder, 65534, -1)

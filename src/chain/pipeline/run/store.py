@@ -183,8 +183,8 @@ class Store:
         return cls(root, fd, group)
 
     def entry(self, key: str) -> Path:
-        """The path of ``key``'s entry, for messages (it may not exist; reads go through
-        the store's descriptor)."""
+        """The path of the entry of ``key`` (a store key: 64 hex digits), for messages;
+        it may not exist, and reads go through the store's descriptor."""
         return self.root / key[:2] / key
 
     def fetch(self, key: str, outputs: list[str]) -> dict | None:
@@ -194,6 +194,13 @@ class Store:
         when every file matched its manifest; SIGINT and SIGTERM meanwhile remove the
         staged copies, and what a killed fetch left beside the outputs goes first
         (:func:`remove_stale_staging`).
+
+        Parameters
+        ----------
+        key : str
+            The job's key (64 hex digits).
+        outputs : list of str
+            The job's output paths, in the order they were stored.
 
         Raises
         ------
@@ -222,6 +229,7 @@ class Store:
         Parameters
         ----------
         key : str
+            The job's key (64 hex digits).
         count : int
             The job's number of outputs.
 
@@ -254,6 +262,17 @@ class Store:
         ``replace``; one whose manifest is damaged is replaced. Every stored file and
         folder is flushed to disk before the entry is renamed into place.
 
+        Parameters
+        ----------
+        key : str
+            The job's key (64 hex digits).
+        outputs : list of str
+            The job's output paths (files or folders), in order.
+        about : dict
+            JSON values the manifest records beside the files.
+        replace : bool
+            Replace an entry already stored (a forced run).
+
         Returns
         -------
         dict
@@ -284,8 +303,8 @@ class Store:
             os.close(tmp)
 
     def discard(self, key: str) -> None:
-        """Remove ``key``'s entry (renamed away first: a reader sees it whole or not).
-        Nothing happens where the store cannot be written (a read-only disk)."""
+        """Remove the entry of ``key`` (64 hex digits), renamed away first: a reader sees
+        it whole or not. Nothing happens where the store cannot be written."""
         try:
             prefix = os.open(key[:2], FOLDER_FLAGS, dir_fd=self._fd)
         except OSError:

@@ -90,8 +90,8 @@ def open_store_folder(root: Path, create: bool, mode: int, group: int | None) ->
     try:
         for depth in range(1, len(real.parts) + 1):
             here, last = Path(*real.parts[:depth]), depth == len(real.parts)
-            made = (mode, group) if last else (ordinary_mode(directory=True) & ~0o022, None)
-            child = _open_or_make(fd, here, create, *made)
+            made = mode if last else ordinary_mode(directory=True) & ~0o022
+            child = _open_or_make(fd, here, create, made)
             if fd is not None:
                 os.close(fd)
             fd = child
@@ -114,9 +114,9 @@ def open_store_folder(root: Path, create: bool, mode: int, group: int | None) ->
         raise
 
 
-def _open_or_make(parent: int | None, here: Path, create: bool, mode: int, group) -> int | None:
+def _open_or_make(parent: int | None, here: Path, create: bool, mode: int) -> int | None:
     """Open the folder ``here`` (``parent``'s, never through a link), made with ``mode``
-    (and ``group``) if missing and ``create``; None if missing and not."""
+    if missing and ``create``; None if missing and not."""
     try:
         return os.open(here.name or "/", FOLDER_FLAGS, dir_fd=parent)
     except FileNotFoundError:
@@ -127,16 +127,17 @@ def _open_or_make(parent: int | None, here: Path, create: bool, mode: int, group
     except FileExistsError:  # made meanwhile by another run: checked as found
         return os.open(here.name, FOLDER_FLAGS, dir_fd=parent)
     fd = os.open(here.name, FOLDER_FLAGS, dir_fd=parent)
-    if group is not None:
-        os.fchown(fd, -1, group)
-    os.fchmod(fd, mode)  # whatever the umask: a group store's folder is the group's
+    os.fchmod(fd, mode)  # whatever the umask
     return fd
 
 
 def _share(fd: int, mode: int, group: int | None) -> None:
-    """A group store's folder of the user's, shared with its group as it should be."""
+    """A group store's folder of the user's given its group and ``mode`` (2770), as
+    another member's runs need it whatever the umask it was made under; never one
+    that others may have written (everyone, or another group): that one is refused."""
     info = os.fstat(fd)
-    if group is None or info.st_uid != os.getuid():
+    others = info.st_mode & 0o002 or (info.st_mode & 0o020 and info.st_gid != group)
+    if group is None or info.st_uid != os.getuid() or others:
         return
     if info.st_gid != group:
         os.fchown(fd, -1, group)
