@@ -90,7 +90,8 @@ def open_store_folder(root: Path, create: bool, mode: int, group: int | None) ->
     try:
         for depth in range(1, len(real.parts) + 1):
             here, last = Path(*real.parts[:depth]), depth == len(real.parts)
-            made = mode if last else ordinary_mode(directory=True) & ~0o022
+            # The store is made private; _share then gives a group's store its group.
+            made = mode & 0o700 if last else ordinary_mode(directory=True) & ~0o022
             child = _open_or_make(fd, here, create, made)
             if fd is not None:
                 os.close(fd)
