@@ -367,7 +367,7 @@ def lab_group():
     runs = [p for p in PYTHONS if p and as_account(65534, [], python=p).returncode == 0]
     if not runs:
         pytest.skip(f"uid 65534 can run no Python that imports {SOURCE}/chain: {PYTHONS}")
-    name = f"hzlab{os.getpid()}"
+    name = f"hzlab{os.getpid()}{os.urandom(2).hex()}"
     subprocess.run(["groupadd", name], check=True, capture_output=True)
     try:
         subprocess.run(["gpasswd", "-a", "nobody", name], check=True, capture_output=True)
