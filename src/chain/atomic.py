@@ -2,7 +2,9 @@
 
 An interrupted job (Ctrl-C, a killed Snakemake job, a full disk) therefore never leaves
 a half-written file under the final name; ``os.replace`` is atomic on POSIX file
-systems. Every file the library writes goes through :func:`atomic_output`.
+systems. The bytes are flushed to disk (:func:`sync`) before the rename and the rename
+after it, so a power cut leaves the old file or the whole new one, never an empty one
+under the final name. Every file the library writes goes through :func:`atomic_output`.
 """
 
 from __future__ import annotations
@@ -29,6 +31,23 @@ def ordinary_mode(directory: bool = False) -> int:
         Bits for a folder (0777 less the umask) instead of a file (0666 less the umask).
     """
     return (0o777 if directory else 0o666) & ~_umask()
+
+
+def sync(path: str | os.PathLike, directory: bool = False) -> None:
+    """Flush a file's bytes, or a folder's list of names, to disk (``fsync``).
+
+    Parameters
+    ----------
+    path : path
+        A file, or a folder.
+    directory : bool
+        ``path`` is a folder (its renames and new names are flushed).
+    """
+    fd = os.open(path, os.O_RDONLY | (os.O_DIRECTORY if directory else 0) | os.O_CLOEXEC)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _umask() -> int:
@@ -99,7 +118,9 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     with temporary_beside(path) as temporary:
         yield temporary
         os.chmod(temporary, ordinary_mode())
+        sync(temporary)
         os.replace(temporary, path)
+    sync(path.parent, directory=True)
 
 
 def write_text_atomic(text: str, path: str | os.PathLike) -> None:
@@ -142,11 +163,23 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
 
 def replace_folder(staging: Path, out: Path) -> None:
     """Move ``staging`` to ``out``; an existing ``out`` (a dataset) is swapped out first
-    and deleted, so a reader sees the old dataset or the new one, never a mixture."""
-    if not out.exists():
+    and deleted, so a reader sees the old dataset or the new one, never a mixture. The
+    files in ``staging`` are written by :func:`atomic_output` (flushed); ``staging``'s
+    list of them is flushed before the rename.
+
+    Parameters
+    ----------
+    staging : Path
+        The new dataset's folder, beside ``out``.
+    out : Path
+        The dataset's final folder.
+    """
+    sync(staging, directory=True)
+    if out.exists():
+        old = out.parent / f".{out.name}.old.{os.urandom(4).hex()}"
+        os.replace(out, old)
         os.replace(staging, out)
-        return
-    old = out.parent / f".{out.name}.old.{os.urandom(4).hex()}"
-    os.replace(out, old)
-    os.replace(staging, out)
-    shutil.rmtree(old, ignore_errors=True)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(staging, out)
+    sync(out.parent, directory=True)

@@ -33,6 +33,9 @@ commands:
   check      check a pipeline run: every contract file present, headline numbers
              (C, exponents, SSW slopes, C_bal, energy drift) within tolerance of a
              committed reference; warns when its packages differ from the lock
+  store      the result store's folder, number of entries and size; `store prune`
+             removes the entries no run folder under results/ shows (--older-than:
+             and those stored before a date; --dry-run: only say what would go)
 
 Beads are numbered 1..N as in the paper. Units: SI (m, s, m/s, N).
 Example:
@@ -90,7 +93,14 @@ def _build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="command")
-    for add_command in (_add_simulate, _add_analyse, _add_theory, _add_check, _add_check_config):
+    for add_command in (
+        _add_simulate,
+        _add_analyse,
+        _add_theory,
+        _add_check,
+        _add_check_config,
+        _add_store,
+    ):
         add_command(commands)
     return parser
 
@@ -237,6 +247,67 @@ def _add_check_config(commands) -> None:
     check.add_argument("configfiles", nargs="+", help="YAML config files")
 
 
+def _add_store(commands) -> None:
+    store = commands.add_parser(
+        "store",
+        help="what the result store holds, and pruning it",
+        description="Print the result store's folder (HERTZCHAIN_STORE, default "
+        "results/.store), its number of entries and their size. Creates nothing.",
+    )
+    actions = store.add_subparsers(dest="action", metavar="action")
+    prune = actions.add_parser(
+        "prune",
+        help="remove the entries no run folder shows",
+        description="Remove the entries that no run folder under results/ holds (its "
+        "SHA256SUMS lists every file of the entry at its path with the stored SHA-256), "
+        "and with --older-than those stored before that day, held or not.",
+    )
+    prune.add_argument(
+        "--older-than",
+        type=_day,
+        metavar="YYYY-MM-DD",
+        help="also remove the entries stored before this day, whether held or not",
+    )
+    prune.add_argument(
+        "--dry-run", action="store_true", help="say what would go and the bytes it frees"
+    )
+    prune.add_argument(
+        "--results", default="results", help="the folder of the run folders (default results)"
+    )
+
+
+def _day(text: str):
+    import datetime
+
+    try:
+        return datetime.date.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a day (YYYY-MM-DD)") from None
+
+
+def _store(args: argparse.Namespace) -> int:
+    import os
+
+    from chain.pipeline.run import store_admin
+    from chain.pipeline.run.store import DEFAULT_FOLDER, STORE_VARIABLE, Store, StoreError
+
+    try:
+        store = Store.open(os.environ, create=False)
+    except StoreError as error:
+        print(f"hertzchain store: error: {error}", file=sys.stderr)
+        return 2
+    if store is None:
+        print(f"no result store at {os.environ.get(STORE_VARIABLE) or DEFAULT_FOLDER}")
+        return 0
+    with store:
+        if args.action == "prune":
+            lines = store_admin.prune(store, args.results, args.older_than, args.dry_run)
+        else:
+            lines = [store_admin.describe(store)]
+    print("\n".join(lines))
+    return 0
+
+
 def _check_config(args: argparse.Namespace) -> int:
     from chain.pipeline.config.files import main as check_config_files
 
@@ -375,6 +446,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "theory": _theory,
         "check": _check,
         "check-config": _check_config,
+        "store": _store,
     }
     try:
         return handlers[args.command](args)

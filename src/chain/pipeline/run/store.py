@@ -1,43 +1,72 @@
 """The result store: files a job made, kept under a key of everything the job read,
-checked byte for byte whenever they are handed on (issue 52).
+checked byte for byte whenever they are handed on.
 
 An entry is a folder ``<store>/<key[:2]>/<key>/`` holding ``files/<i>`` (the job's
 i-th output: a file, or a folder of files) and ``manifest.json`` (each file's SHA-256
 and size, recorded as it was stored). Entries appear whole: they are written in
-``<store>/tmp/`` and renamed into place, so a killed run leaves no partial entry and two
-runs storing one key at once keep one. Stored files are read-only; the store is the
-user's alone (0700, files as the umask allows but never writable) unless it is shared
-on purpose with one group (:data:`GROUP_VARIABLE`), never with everyone. A reader
-copies each file while hashing it and renames the copies into place only if every
-digest is the recorded one: a file altered, truncated or replaced after it was stored
-is found, the entry discarded and the job computed anew (:class:`BadEntry`).
+``<store>/tmp/``, flushed to disk, and renamed into place, so a killed run leaves no
+partial entry and two runs storing one key at once keep one. Stored files are
+read-only; the store is the user's alone (0700) unless it is shared on purpose with
+one group (:data:`GROUP_VARIABLE`: 2770, files 0440), never with everyone. Its whole
+path is checked as it is opened, and it is held by descriptor from then on
+(:mod:`chain.pipeline.run.store_path`). A reader copies each file while hashing it
+and renames the copies into place only if every digest is the recorded one: a file
+altered, truncated or replaced after it was stored is found, the entry discarded and
+the job computed anew (:class:`BadEntry`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
-import grp
 import hashlib
 import json
 import os
+import re
 import shutil
 import stat
+import weakref
+from collections.abc import Iterator
 from pathlib import Path
 
-from chain.atomic import ordinary_mode
+from chain.atomic import ordinary_mode, sync
+from chain.pipeline.run.staging import (
+    FOLDER_FLAGS,
+    interruptible,
+    remove_at,
+    remove_stale_staging,
+    staging_name,
+)
+from chain.pipeline.run.store_path import (
+    GROUP_VARIABLE,
+    STORE_VARIABLE,
+    StoreError,
+    group_id,
+    open_store_folder,
+)
 
-#: Environment variable naming the store's folder (default :data:`DEFAULT_FOLDER`).
-STORE_VARIABLE = "HERTZCHAIN_STORE"
-#: Environment variable naming the one group the store is shared with, if any.
-GROUP_VARIABLE = "HERTZCHAIN_STORE_GROUP"
+__all__ = [
+    "DEFAULT_FOLDER",
+    "GROUP_VARIABLE",
+    "STORE_VARIABLE",
+    "BadEntry",
+    "Store",
+    "StoreError",
+    "file_digest",
+    "remove_stale_staging",
+    "stored_digest",
+]
+
 #: The store's folder relative to the working directory: ``rm -r results`` empties it.
 DEFAULT_FOLDER = Path("results") / ".store"
 
 _CHUNK = 1 << 20  # bytes read at a time
-
-
-class StoreError(RuntimeError):
-    """The store cannot be used safely; the message names its folder."""
+# A regular file, never through a link; a FIFO put in its place does not block.
+_READ = os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC
+_CREATE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+# What a rename onto an entry's name says when something is there already.
+_TAKEN = (errno.EEXIST, errno.ENOTEMPTY, errno.ENOTDIR, errno.EISDIR)
+_KEY = re.compile(r"[0-9a-f]{64}")
 
 
 class BadEntry(Exception):
@@ -80,29 +109,45 @@ def _files_under(folder: Path) -> list[str]:
 
 
 class Store:
-    """A store folder, made or checked by :meth:`open`.
+    """A store folder, opened by :meth:`open` and held by descriptor: every access goes
+    through it, whatever its path names later.
 
     Parameters
     ----------
     root : Path
-        The store's folder.
+        The store's folder, as the user named it (for messages).
+    fd : int
+        Its open descriptor (closed with the store: :meth:`close`).
     group : int or None
         The id of the group it is shared with; None: the user's alone.
     """
 
-    def __init__(self, root: Path, group: int | None = None):
+    def __init__(self, root: Path, fd: int, group: int | None = None):
         self.root, self.group = Path(root), group
         # Read-only; for a group, readable by it whatever the umask, never by others.
         self.file_mode = 0o444 & ordinary_mode() if group is None else 0o440
         self.folder_mode = 0o700 if group is None else 0o2770
+        self._fd = fd
+        self._closer = weakref.finalize(self, os.close, fd)
+
+    def close(self) -> None:
+        """Close the store's descriptor (done too when the store is collected)."""
+        self._closer()
+
+    def __enter__(self) -> Store:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     @classmethod
-    def open(
-        cls, environ, working_directory: str | os.PathLike = ".", create: bool = True
-    ) -> Store | None:
+    def open(cls, environ, working_directory: str | os.PathLike = ".", create: bool = True):
         """The store the environment names (:data:`STORE_VARIABLE`, relative to
-        ``working_directory``; default :data:`DEFAULT_FOLDER`), made if missing; refused
-        (:class:`StoreError`) if another user owns it or others may write it.
+        ``working_directory``; default :data:`DEFAULT_FOLDER`), its whole path checked
+        (:func:`chain.pipeline.run.store_path.open_store_folder`); made if missing when
+        ``create``, and then what killed runs of this machine left in its ``tmp``
+        removed. Returns the :class:`Store`, or None when it is missing and not
+        ``create``.
 
         Parameters
         ----------
@@ -111,53 +156,47 @@ class Store:
         working_directory : path
             Where a relative store folder starts (Snakemake's working directory).
         create : bool
-            Make the folder if it is missing; else a missing store is None.
+            Make what is missing. False writes nothing (a dry run).
+
+        Raises
+        ------
+        StoreError
+            A folder of its path is not safe, or it cannot be made; the message names
+            the folder and the fix.
         """
         root = Path(working_directory) / (environ.get(STORE_VARIABLE) or DEFAULT_FOLDER)
-        group = environ.get(GROUP_VARIABLE) or None
-        try:
-            gid = None if group is None else grp.getgrnam(group).gr_gid
-        except KeyError:
-            raise StoreError(f"{GROUP_VARIABLE}={group}: no such group") from None
-        store = cls(root, gid)
-        if not create and not root.is_dir():
+        group = group_id(environ.get(GROUP_VARIABLE))
+        fd = open_store_folder(root, create, 0o700 if group is None else 0o2770, group)
+        if fd is None:
             return None
-        try:
-            root.mkdir(parents=True, exist_ok=True, mode=store.folder_mode)
-        except OSError as error:
-            raise StoreError(
-                f"result store {root}: {error.strerror}; set {STORE_VARIABLE} to a folder "
-                "you can write, or run with --config reuse=False"
-            ) from None
-        store._check_root()
-        return store
-
-    def _check_root(self) -> None:
-        """Refuse a store that someone else may have written to: another user's, or
-        one writable by others than the user (and the group it is shared with)."""
-        info = self.root.stat()
-        mode = stat.S_IMODE(info.st_mode)
-        where = f"result store {self.root}"
-        if info.st_uid != os.getuid():
-            raise StoreError(f"{where} belongs to uid {info.st_uid}, not to you")
-        if mode & 0o002 or (self.group is None and mode & 0o020):
-            raise StoreError(
-                f"{where} is writable by others (mode {mode:04o}): empty it "
-                f"(`rm -r {self.root}`) or `chmod 700` it if you trust what it holds; "
-                f"{GROUP_VARIABLE} shares a store with one group on purpose"
-            )
-        if self.group is not None and (info.st_gid, mode) != (self.group, self.folder_mode):
-            os.chown(self.root, -1, self.group)
-            os.chmod(self.root, self.folder_mode)
+        if create:
+            with contextlib.suppress(OSError):
+                tmp = os.open("tmp", FOLDER_FLAGS, dir_fd=fd)
+                try:
+                    remove_stale_staging(tmp)
+                finally:
+                    os.close(tmp)
+        return cls(root, fd, group)
 
     def entry(self, key: str) -> Path:
-        """The folder of ``key``'s entry (it may not exist)."""
+        """The path of the entry of ``key`` (a store key: 64 hex digits), for messages;
+        it may not exist, and reads go through the store's descriptor."""
         return self.root / key[:2] / key
 
     def fetch(self, key: str, outputs: list[str]) -> dict | None:
         """Copy ``key``'s stored files to ``outputs`` (paths, in order) and return the
-        entry's manifest; None if there is no entry. Each copy is hashed as it is
-        written and renamed into place only when every file matched its manifest.
+        entry's manifest; None if there is no entry. Each copy is staged beside its
+        output, hashed as it is written, flushed to disk, and renamed into place only
+        when every file matched its manifest; SIGINT and SIGTERM meanwhile remove the
+        staged copies, and what a killed fetch left beside the outputs goes first
+        (:func:`remove_stale_staging`).
+
+        Parameters
+        ----------
+        key : str
+            The job's key (64 hex digits).
+        outputs : list of str
+            The job's output paths, in the order they were stored.
 
         Raises
         ------
@@ -165,177 +204,447 @@ class Store:
             The entry is damaged (the message names the file); it has been discarded,
             and no output was written.
         """
-        entry = self.entry(key)
-        if not entry.is_dir():
-            return None
-        copies: list[tuple[Path, Path]] = []
         try:
-            manifest = self._manifest(entry, len(outputs))
-            for i, (out, files) in enumerate(zip(outputs, manifest["outputs"])):
-                copies.append((self._copy_checked(entry / "files" / str(i), files, out), out))
+            entry = self._open_entry(key)
+            if entry is None:
+                return None
+            try:
+                manifest = _manifest(entry, len(outputs))
+                _copy_out(entry, manifest, [Path(out) for out in outputs])
+            finally:
+                os.close(entry)
         except BadEntry:
-            for copy, _ in copies:
-                _remove(copy)
             self.discard(key)
             raise
-        for copy, out in copies:
-            if Path(out).is_dir():
-                shutil.rmtree(out)
-            os.replace(copy, out)
         return manifest
 
     def verify(self, key: str, count: int) -> dict | None:
-        """Check ``key``'s entry of ``count`` outputs, every file against its manifest,
-        without copying or changing anything; its manifest, or None if there is none.
+        """Check every file of ``key``'s entry against its manifest, copying nothing and
+        writing nothing (a dry run); the manifest, or None if there is no entry.
+
+        Parameters
+        ----------
+        key : str
+            The job's key (64 hex digits).
+        count : int
+            The job's number of outputs.
 
         Raises
         ------
         BadEntry
-            The entry is damaged (the message names the file).
+            The entry is damaged (the message names the file); it is left in place.
         """
-        entry = self.entry(key)
-        if not entry.is_dir():
+        entry = self._open_entry(key)
+        if entry is None:
             return None
-        manifest = self._manifest(entry, count)
-        for i, files in enumerate(manifest["outputs"]):
-            stored = entry / "files" / str(i)
-            found = set(_files_under(stored)) if stored.is_dir() else {""}
-            if found != set(files):
-                raise BadEntry(f"{stored.name}: files {sorted(found ^ set(files))} differ")
-            for name, (sha256, size) in files.items():
-                got = _hash_regular(stored / name if name else stored)
-                if got != (sha256, size):
-                    raise BadEntry(f"files/{i}{'/' + name if name else ''}: SHA-256 "
-                                   f"{got[0][:12]}... ({got[1]} bytes), stored as "
-                                   f"{sha256[:12]}... ({size} bytes)")  # fmt: skip
+        try:
+            manifest = _manifest(entry, count)
+            files = _folder_at(entry, "files")
+            try:
+                for i, record in enumerate(manifest["outputs"]):
+                    paths = manifest.get("paths") or []
+                    label = str(paths[i]) if i < len(paths) else f"files/{i}"
+                    _check_output(files, str(i), record, label, None)
+            finally:
+                os.close(files)
+        finally:
+            os.close(entry)
         return manifest
 
     def recorded(self, key: str) -> dict | None:
         """``key``'s manifest as recorded (unchecked), or None if absent or unreadable."""
-        try:
-            return json.loads((self.entry(key) / "manifest.json").read_text())
-        except (OSError, ValueError):
+        entry = self._open_entry(key)
+        if entry is None:
             return None
-
-    def _manifest(self, entry: Path, count: int) -> dict:
         try:
-            manifest = json.loads((entry / "manifest.json").read_text())
-            if len(manifest["outputs"]) != count:
-                raise ValueError(f"{len(manifest['outputs'])} outputs, the job has {count}")
-            return manifest
-        except (OSError, ValueError, KeyError, TypeError) as error:
-            raise BadEntry(f"manifest.json unreadable ({error})") from None
-
-    def _copy_checked(self, stored: Path, files: dict, out: str) -> Path:
-        """A private copy of ``stored`` beside ``out``, each file checked against
-        ``files`` (name -> [sha256, size]; "" names a stored file itself)."""
-        out = Path(out)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        copy = out.parent / f".{out.name}.{os.urandom(4).hex()}"
-        found = set(_files_under(stored)) if stored.is_dir() else {""}
-        if found != set(files):
-            raise BadEntry(f"{stored.name}: files {sorted(found ^ set(files))} differ")
-        try:
-            for name, (sha256, size) in files.items():
-                target = copy / name if name else copy
-                target.parent.mkdir(parents=True, exist_ok=True)
-                got = _copy_hashing(stored / name if name else stored, target)
-                if got != (sha256, size):
-                    raise BadEntry(
-                        f"{out.name}{'/' + name if name else ''}: SHA-256 {got[0][:12]}... "
-                        f"({got[1]} bytes), stored as {sha256[:12]}... ({size} bytes)"
-                    )
-        except BaseException:
-            _remove(copy)
-            raise
-        return copy
+            return _manifest(entry, None)
+        except BadEntry:
+            return None
+        finally:
+            os.close(entry)
 
     def put(self, key: str, outputs: list[str], about: dict, replace: bool = False) -> dict:
         """Store the files ``outputs`` (paths, in order) under ``key``, with ``about``
-        (who stored them) in the manifest. An existing entry is kept (another run
-        stored the same result) unless ``replace``. Returns the manifest of the entry
-        that stands: each output's files with their SHA-256 and size.
-        """
-        tmp = self.root / "tmp"
-        tmp.mkdir(exist_ok=True, mode=self.folder_mode)
-        staging = tmp / f"{key}.{os.urandom(4).hex()}"
-        try:
-            os.mkdir(staging, self.folder_mode)
-            os.mkdir(staging / "files", self.folder_mode)
-            records = [
-                self._stage(Path(out), staging / "files" / str(i)) for i, out in enumerate(outputs)
-            ]
-            manifest = {**about, "key": key, "outputs": records}
-            (staging / "manifest.json").write_text(json.dumps(manifest, indent=1))
-            os.chmod(staging / "manifest.json", self.file_mode)
-            final = self.entry(key)
-            final.parent.mkdir(exist_ok=True, mode=self.folder_mode)
-            if replace and final.exists():
-                self.discard(key)
-            os.rename(staging, final)
-            return manifest
-        except OSError as error:
-            if error.errno in (errno.EEXIST, errno.ENOTEMPTY) and self.entry(key).is_dir():
-                return {**manifest, **(self.recorded(key) or {})}  # stored meanwhile
-            raise
-        finally:
-            _remove(staging)
+        (who stored them, when: ``run``, ``stored``, ``paths``...) in the manifest.
+        An existing entry is kept (another run stored the same result) unless
+        ``replace``; one whose manifest is damaged is replaced. Every stored file and
+        folder is flushed to disk before the entry is renamed into place.
 
-    def _stage(self, out: Path, stored: Path) -> dict:
-        """Copy one output into an entry being written; its files' [sha256, size]."""
-        names = _files_under(out) if out.is_dir() else [""]
-        files = {}
-        for name in names:
-            target = stored / name if name else stored
-            for folder in [Path("."), *reversed(Path(name).parents[:-1])] if name else []:
-                (stored / folder).mkdir(exist_ok=True, mode=self.folder_mode)
-            files[name] = list(_copy_hashing(out / name if name else out, target))
-            os.chmod(target, self.file_mode)
-        return files
+        Parameters
+        ----------
+        key : str
+            The job's key (64 hex digits).
+        outputs : list of str
+            The job's output paths (files or folders), in order.
+        about : dict
+            JSON values the manifest records beside the files.
+        replace : bool
+            Replace an entry already stored (a forced run).
+
+        Returns
+        -------
+        dict
+            The manifest now stored under ``key``: this call's, or the kept entry's.
+            ``outputs[i]`` maps each file of output i to [SHA-256, size in bytes]
+            ("" for an output that is a file).
+        """
+        tmp = self._made(self._fd, "tmp")
+        name = staging_name()
+        try:
+            staging = self._made(tmp, name)
+            try:
+                files = self._made(staging, "files")
+                try:
+                    records = [self._stage(Path(p), files, str(i)) for i, p in enumerate(outputs)]
+                    os.fsync(files)
+                finally:
+                    os.close(files)
+                manifest = {**about, "key": key, "outputs": records}
+                text = json.dumps(manifest, indent=1).encode()
+                self._write(staging, "manifest.json", lambda out: _write_all(out, text))
+                os.fsync(staging)
+            finally:
+                os.close(staging)
+            return self._install(tmp, name, key, manifest, replace)
+        finally:
+            remove_at(tmp, name)  # a failed put's staging (none once installed)
+            os.close(tmp)
 
     def discard(self, key: str) -> None:
-        """Remove ``key``'s entry (renamed away first: a reader sees it whole or not)."""
-        entry = self.entry(key)
-        gone = self.root / "tmp" / f"discarded.{key}.{os.urandom(4).hex()}"
+        """Remove the entry of ``key`` (64 hex digits), renamed away first: a reader sees
+        it whole or not. Nothing happens where the store cannot be written."""
         try:
-            gone.parent.mkdir(exist_ok=True, mode=self.folder_mode)
-            os.rename(entry, gone)
-        except OSError:  # gone already, or a read-only store: never handed on anyway
+            prefix = os.open(key[:2], FOLDER_FLAGS, dir_fd=self._fd)
+        except OSError:
             return
-        _remove(gone)
+        try:
+            tmp = self._made(self._fd, "tmp")
+            try:
+                gone = staging_name()
+                os.rename(key, gone, src_dir_fd=prefix, dst_dir_fd=tmp)
+                remove_at(tmp, gone)
+            finally:
+                os.close(tmp)
+        except OSError:  # gone already, or a read-only store: never handed on anyway
+            pass
+        finally:
+            os.close(prefix)
+
+    def entries(self) -> Iterator[tuple[str, dict | None, int]]:
+        """Every entry of the store: its key, its manifest (None if unreadable) and its
+        size (bytes of its files and manifest)."""
+        with os.scandir(self._fd) as found:
+            prefixes = sorted(e.name for e in found if re.fullmatch("[0-9a-f]{2}", e.name))
+        for name in prefixes:
+            try:
+                prefix = os.open(name, FOLDER_FLAGS, dir_fd=self._fd)
+            except OSError:
+                continue
+            try:
+                with os.scandir(prefix) as found:
+                    keys = sorted(e.name for e in found if _KEY.fullmatch(e.name))
+                for key in keys:
+                    try:
+                        found = _manifest_and_size(prefix, key)
+                    except OSError:  # removed meanwhile
+                        continue
+                    yield key, *found
+            finally:
+                os.close(prefix)
+
+    def _open_entry(self, key: str) -> int | None:
+        """The descriptor of ``key``'s entry; None if there is none."""
+        if not _KEY.fullmatch(key):
+            raise ValueError(f"{key!r} is not a store key (64 hex digits)")
+        try:
+            prefix = os.open(key[:2], FOLDER_FLAGS, dir_fd=self._fd)
+        except OSError:
+            return None
+        try:
+            return os.open(key, FOLDER_FLAGS, dir_fd=prefix)
+        except FileNotFoundError:
+            return None
+        except OSError as error:  # a link or a file in its place
+            raise BadEntry(f"{key}: {error.strerror}") from None
+        finally:
+            os.close(prefix)
+
+    def _made(self, parent: int, name: str) -> int:
+        """The descriptor of the store folder ``name`` of ``parent``, made if missing."""
+        try:
+            os.mkdir(name, self.folder_mode, dir_fd=parent)
+        except FileExistsError:
+            return os.open(name, FOLDER_FLAGS, dir_fd=parent)
+        fd = os.open(name, FOLDER_FLAGS, dir_fd=parent)
+        self._own(fd, self.folder_mode)
+        return fd
+
+    def _own(self, fd: int, mode: int) -> None:
+        """Give a new file or folder the store's group (if any) and ``mode``, whatever
+        the umask (group first: a change of group may clear the set-group-id bit)."""
+        if self.group is not None and os.fstat(fd).st_gid != self.group:
+            os.fchown(fd, -1, self.group)
+        os.fchmod(fd, mode)
+
+    def _write(self, folder: int, name: str, write) -> None:
+        """Make the file ``name`` in ``folder``, ``write(fd)`` it, make it read-only
+        (the store's file mode) and flush it to disk."""
+        out = os.open(name, _CREATE, 0o600, dir_fd=folder)
+        try:
+            write(out)
+            self._own(out, self.file_mode)
+            os.fsync(out)
+        finally:
+            os.close(out)
+
+    def _stage(self, out: Path, files: int, name: str) -> dict:
+        """Copy one output into an entry being written; its files' [sha256, size]."""
+        if not out.is_dir():
+            return {"": self._store_file(out, files, name)}
+        record: dict = {}
+        folder = self._made(files, name)
+        try:
+            self._stage_tree(out, folder, "", record)
+        finally:
+            os.close(folder)
+        return record
+
+    def _stage_tree(self, source: Path, folder: int, prefix: str, record: dict) -> None:
+        """Copy the files below ``source`` into ``folder`` (those :func:`_files_under`
+        lists), recording each under ``prefix`` + its name; flush the folder."""
+        with os.scandir(source) as found:
+            entries = sorted(found, key=lambda entry: entry.name)
+        for entry in entries:
+            if entry.is_dir(follow_symlinks=False):
+                sub = self._made(folder, entry.name)
+                try:
+                    self._stage_tree(Path(entry.path), sub, f"{prefix}{entry.name}/", record)
+                finally:
+                    os.close(sub)
+            elif entry.is_file() and not entry.name.startswith("."):
+                record[prefix + entry.name] = self._store_file(Path(entry.path), folder, entry.name)
+        os.fsync(folder)
+
+    def _store_file(self, source: Path, folder: int, name: str) -> list:
+        """Copy the regular file ``source`` to ``name`` in ``folder``: [sha256, size]."""
+        got = []
+        read = _open_regular(None, source)
+        try:
+            self._write(folder, name, lambda out: got.extend(_copy_hashing(read, out)))
+        finally:
+            os.close(read)
+        return got
+
+    def _install(self, tmp: int, name: str, key: str, manifest: dict, replace: bool) -> dict:
+        """Rename the staged entry ``name`` into place; the manifest then stored."""
+        prefix = self._made(self._fd, key[:2])
+        try:
+            if replace:
+                self.discard(key)
+            for _ in range(3):
+                try:
+                    os.rename(name, key, src_dir_fd=tmp, dst_dir_fd=prefix)
+                except OSError as error:
+                    if error.errno not in _TAKEN:
+                        raise
+                else:
+                    os.fsync(prefix)
+                    return manifest
+                try:  # stored meanwhile by another run: one entry is kept
+                    kept = _manifest_and_size(prefix, key, len(manifest["outputs"]))[0]
+                except (BadEntry, OSError):
+                    kept = None
+                if kept is not None:
+                    return kept
+                self.discard(key)  # damaged: replaced
+        finally:
+            os.close(prefix)
+        raise OSError(errno.EEXIST, "a damaged entry cannot be replaced", str(self.entry(key)))
 
 
-def _copy_hashing(source: Path, target: Path) -> tuple[str, int]:
-    """Copy a regular file (never a link), returning the copy's (SHA-256, size)."""
-    digest, size = hashlib.sha256(), 0
+def _manifest(entry: int, count: int | None) -> dict:
+    """The manifest of the open entry ``entry``, with ``count`` outputs (any: None)."""
     try:
-        fd = os.open(source, os.O_RDONLY | os.O_NOFOLLOW)
-    except OSError as error:  # gone, or a link put in its place
-        raise BadEntry(f"{source.name}: {error.strerror}") from None
-    with open(fd, "rb") as stream, open(target, "xb") as copy:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise BadEntry(f"{source.name} is not a regular file")
-        while chunk := stream.read(_CHUNK):
-            digest.update(chunk)
-            size += len(chunk)
-            copy.write(chunk)
-    return digest.hexdigest(), size
+        fd = _open_regular(entry, "manifest.json")
+        with open(fd, "rb") as stream:
+            manifest = json.loads(stream.read())
+        outputs = manifest["outputs"]
+        if count is not None and len(outputs) != count:
+            raise ValueError(f"{len(outputs)} outputs, the job has {count}")
+        if not all(
+            isinstance(files, dict) and all(len(v) == 2 for v in files.values())
+            for files in outputs
+        ):
+            raise ValueError("an output's record is not {file: [sha256, size]}")
+        return manifest
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise BadEntry(f"manifest.json unreadable ({error})") from None
 
 
-def _hash_regular(path: Path) -> tuple[str, int]:
-    """(SHA-256, size) of a regular file, never through a link."""
-    digest, size = hashlib.sha256(), 0
+def _manifest_and_size(prefix: int, key: str, count: int | None = None):
+    """(manifest or None if unreadable, size in bytes) of the entry ``key`` of the open
+    folder ``prefix``."""
+    entry = os.open(key, FOLDER_FLAGS, dir_fd=prefix)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
+        try:
+            manifest = _manifest(entry, count)
+        except BadEntry:
+            manifest = None
+        size = 0
+        for _, _, names, folder in os.fwalk(".", dir_fd=entry):
+            for name in names:
+                info = os.stat(name, dir_fd=folder, follow_symlinks=False)
+                size += info.st_size if stat.S_ISREG(info.st_mode) else 0
+        return manifest, size
+    finally:
+        os.close(entry)
+
+
+def _folder_at(parent: int, name: str) -> int:
+    """The descriptor of a stored folder (never through a link), or :class:`BadEntry`."""
+    try:
+        return os.open(name, FOLDER_FLAGS, dir_fd=parent)
     except OSError as error:
-        raise BadEntry(f"{path.name}: {error.strerror}") from None
-    with open(fd, "rb") as stream:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise BadEntry(f"{path.name} is not a regular file")
-        while chunk := stream.read(_CHUNK):
-            digest.update(chunk)
-            size += len(chunk)
+        raise BadEntry(f"{name}: {error.strerror}") from None
+
+
+def _open_regular(parent: int | None, name: str | Path) -> int:
+    """A descriptor for reading the regular file ``name`` (of ``parent``), never
+    through a link: OSError if it is gone, a link, or not a regular file."""
+    fd = os.open(name, _READ, dir_fd=parent)
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise OSError(errno.EINVAL, "not a regular file", os.fspath(name))
+    return fd
+
+
+def _walk(folder: int, prefix: str = "") -> Iterator[tuple[str, int, str]]:
+    """(path below the stored folder, its folder's descriptor, name) of each file below
+    the open ``folder``, sorted, never through a link (a link is listed as a file);
+    hidden files left out, as :func:`_files_under` does."""
+    with os.scandir(folder) as found:
+        entries = sorted((e.name, e.is_dir(follow_symlinks=False)) for e in found)
+    for name, is_dir in entries:
+        if is_dir:
+            sub = _folder_at(folder, name)
+            try:
+                yield from _walk(sub, f"{prefix}{name}/")
+            finally:
+                os.close(sub)
+        elif not name.startswith("."):
+            yield prefix + name, folder, name
+
+
+def _check_output(files: int, name: str, record: dict, label: str, copy: Path | None) -> None:
+    """Check the stored output ``files/<name>`` against its ``record`` (file name ->
+    [sha256, size]; "" names a stored file itself) file by file, copying it to ``copy``
+    meanwhile if given (each file flushed). Raises :class:`BadEntry` naming the file."""
+    try:
+        is_dir = stat.S_ISDIR(os.stat(name, dir_fd=files, follow_symlinks=False).st_mode)
+    except OSError as error:
+        raise BadEntry(f"{label}: {error.strerror}") from None
+    folder = _folder_at(files, name) if is_dir else None
+    try:
+        if copy is not None and is_dir:
+            copy.mkdir()
+        seen = set()
+        for path, parent, leaf in _walk(folder) if is_dir else [("", files, name)]:
+            shown = f"{label}/{path}" if path else label
+            if path not in record:
+                raise BadEntry(f"{shown}: a file the manifest does not list")
+            got = _check_file(parent, leaf, None if copy is None else copy / path, shown)
+            sha256, size = record[path]
+            if got != (sha256, size):
+                raise BadEntry(
+                    f"{shown}: SHA-256 {got[0][:12]}... ({got[1]} bytes), stored as "
+                    f"{str(sha256)[:12]}... ({size} bytes)"
+                )
+            seen.add(path)
+        if set(record) - seen:
+            raise BadEntry(f"{label}: {sorted(set(record) - seen)} missing")
+    finally:
+        if folder is not None:
+            os.close(folder)
+
+
+def _check_file(parent: int, name: str, copy: Path | None, shown: str) -> tuple[str, int]:
+    """(SHA-256, size) of the stored file ``name`` of ``parent``, copied to ``copy``
+    (made, flushed) if given."""
+    try:
+        read = _open_regular(parent, name)
+    except OSError as error:  # gone, or a link put in its place
+        raise BadEntry(f"{shown}: {error.strerror}") from None
+    try:
+        if copy is None:
+            return _copy_hashing(read, None)
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        out = os.open(copy, _CREATE, 0o666)  # a copy of the user's, as the umask allows
+        try:
+            got = _copy_hashing(read, out)
+            os.fsync(out)
+        finally:
+            os.close(out)
+        return got
+    finally:
+        os.close(read)
+
+
+def _copy_hashing(source: int, target: int | None) -> tuple[str, int]:
+    """Read the open file ``source`` to its end, writing it to ``target`` if given;
+    the bytes' (SHA-256, size)."""
+    digest, size = hashlib.sha256(), 0
+    while chunk := os.read(source, _CHUNK):
+        digest.update(chunk)
+        size += len(chunk)
+        if target is not None:
+            _write_all(target, chunk)
     return digest.hexdigest(), size
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+def _copy_out(entry: int, manifest: dict, outputs: list[Path]) -> None:
+    """Copy the open entry's outputs to ``outputs``: staged beside each (what a killed
+    fetch left there removed first), checked, then renamed into place."""
+    for folder in {out.parent for out in outputs}:
+        folder.mkdir(parents=True, exist_ok=True)
+        remove_stale_staging(folder)
+    copies: list[Path] = []
+    with interruptible():
+        try:
+            files = _folder_at(entry, "files")
+            try:
+                for i, (out, record) in enumerate(zip(outputs, manifest["outputs"])):
+                    copies.append(out.parent / staging_name())
+                    _check_output(files, str(i), record, out.name, copies[-1])
+            finally:
+                os.close(files)
+            for copy, out in zip(copies, outputs):
+                _into_place(copy, out)
+        except BaseException:
+            for copy in copies:
+                _remove(copy)
+            raise
+
+
+def _into_place(copy: Path, out: Path) -> None:
+    """Rename the checked ``copy`` to ``out``, flushing what it holds first. A file
+    replaces a file at once; a folder in the way is renamed aside and deleted after."""
+    if copy.is_dir():
+        for folder, _, _ in os.walk(copy, topdown=False):
+            sync(folder, directory=True)
+    if (out.is_dir() and not out.is_symlink()) or (copy.is_dir() and os.path.lexists(out)):
+        old = out.parent / staging_name()
+        os.rename(out, old)
+        os.rename(copy, out)
+        _remove(old)
+    else:
+        os.replace(copy, out)
+    sync(out.parent, directory=True)
 
 
 def _remove(path: Path) -> None:
