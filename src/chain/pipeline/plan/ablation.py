@@ -14,22 +14,13 @@ import json
 from functools import cached_property
 
 from chain.pipeline.config.ablation import ablation_variants, variant_settings, variant_tolerance
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 from chain.studies.ablation_table import overrides_text
 from chain.studies.mechanism_settings import CANDIDATE_REFERENCE
 
 
-class AblationPlan:
-    """The ablation_variant, ablation_twin and ablation_table steps.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class AblationPlan(Part):
+    """The ablation_variant, ablation_twin and ablation_table steps."""
 
     @cached_property
     def variants(self) -> dict[str, dict]:

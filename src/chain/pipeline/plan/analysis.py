@@ -5,7 +5,7 @@ file, so each table is one job."""
 
 from __future__ import annotations
 
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 
 #: The contract tables of every run (tables/<name>.csv), in order.
 TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed".split())
@@ -15,17 +15,8 @@ TABLES = tuple("pulses delays delay_fits ssw ssw_fits ssw_track ssw_speed".split
 PER_TRACE_FILE = {"mem_mb": 1000, "runtime": 30}
 
 
-class AnalysisPlan:
-    """The pulses, delays, delay_fits, ssw, ssw_fits and ssw_speed steps.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class AnalysisPlan(Part):
+    """The pulses, delays, delay_fits, ssw, ssw_fits and ssw_speed steps."""
 
     def table(self, name: str) -> str:
         """``tables/<name>.csv`` of the run."""

@@ -9,21 +9,12 @@ from __future__ import annotations
 
 from functools import cached_property
 
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 from chain.studies.c_sensitivity import sensitivity_plan, shifted_pairs
 
 
-class CSensitivityPlan:
-    """The c_sensitivity and c_sensitivity_table steps (with ``studies.c_sensitivity``).
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class CSensitivityPlan(Part):
+    """The c_sensitivity and c_sensitivity_table steps (with ``studies.c_sensitivity``)."""
 
     @cached_property
     def choices(self) -> dict:

@@ -28,20 +28,11 @@ from chain.pipeline.plan.datasets import (
     experiment_label,
     experiment_parts,
 )
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 
 
-class ExperimentPlan:
-    """The virtual_experiment, experiment_traces and selection steps of a run.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class ExperimentPlan(Part):
+    """The virtual_experiment, experiment_traces and selection steps of a run."""
 
     @cached_property
     def chains(self) -> tuple[ExperimentPart, ...]:
@@ -144,7 +135,3 @@ class ExperimentPlan:
                 report={"0": ("selection.rst", "Tables")},
             ),
         ]  # fmt: skip
-
-    def targets(self) -> list[str]:
-        """None of its own: the analysis and Fig. 2 ask for its files."""
-        return []

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 
 
 @dataclass(frozen=True)
@@ -163,17 +163,8 @@ FIGURES = (
 )  # fmt: skip
 
 
-class FigurePlan:
-    """The figures a run draws (:data:`FIGURES`), as steps.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class FigurePlan(Part):
+    """The figures a run draws (:data:`FIGURES`), as steps."""
 
     def names(self) -> list[str]:
         """The run's figures (contract names), in order."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 from functools import cached_property
 
 from chain.physics.lammps_library import lammps_available
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 from chain.studies.mechanism_settings import (
     CANDIDATE_REFERENCE,
     candidate_variants,
@@ -25,17 +25,8 @@ from chain.studies.mechanism_settings import (
 LAMMPS_KEYS = ("material", "radius_m", "chains", "models", "lammps")
 
 
-class MechanismPlan:
-    """The lammps_check, lammps_check_table, lammps_setting and ssw_mechanisms steps.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class MechanismPlan(Part):
+    """The lammps_check, lammps_check_table, lammps_setting and ssw_mechanisms steps."""
 
     @cached_property
     def lammps(self) -> bool:

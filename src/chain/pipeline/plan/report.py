@@ -7,21 +7,12 @@ from __future__ import annotations
 
 import os
 
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 from chain.studies.mechanism_table import FRICTION_MECHANISM, REFERENCE_MECHANISM
 
 
-class ReportPlan:
-    """The summary, summary_md and article steps.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan (its provenance and workflow folder among its facts).
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class ReportPlan(Part):
+    """The summary, summary_md and article steps."""
 
     def _summary_inputs(self) -> dict:
         plan, t = self.plan, self.plan.analysis.table

@@ -284,5 +284,4 @@ class RunPlan:
 
     def notes(self) -> list[str]:
         """What the console says about the plan before any job (a part skipped)."""
-        parts = [getattr(self, name) for name in self.parts]
-        return [note for part in parts if hasattr(part, "notes") for note in part.notes()]
+        return [note for name in self.parts for note in getattr(self, name).notes()]

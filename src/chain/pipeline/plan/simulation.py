@@ -7,20 +7,11 @@ from __future__ import annotations
 
 from chain.pipeline.plan.jobs import chain_of
 from chain.pipeline.plan.resources import simulation_needs, simulation_threads
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 
 
-class SimulationPlan:
-    """The simulate, ssw_track and ssw_fields steps of a run.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan (its models, chains and simulation jobs).
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class SimulationPlan(Part):
+    """The simulate, ssw_track and ssw_fields steps of a run."""
 
     @property
     def parts(self) -> list[tuple[str, str, int]]:
@@ -118,7 +109,3 @@ class SimulationPlan:
                 priority=3,
             ),
         ]  # fmt: skip
-
-    def targets(self) -> list[str]:
-        """None of its own: the tables and figures ask for its files."""
-        return []

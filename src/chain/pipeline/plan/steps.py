@@ -207,3 +207,29 @@ class Jobs:
             stack.append((job, True))
             stack += [(up, False) for p in job.input_paths if (up := self.producer(p))]
         return order
+
+
+class Part:
+    """A part of the run plan: its facts, its steps and its files of the default run;
+    none of each unless the part says otherwise.
+
+    Parameters
+    ----------
+    plan : RunPlan
+        The run's plan, whose shared facts the part reads.
+    """
+
+    def __init__(self, plan):
+        self.plan = plan
+
+    def steps(self) -> list[Step]:
+        """The part's steps (the rules of its jobs)."""
+        return []
+
+    def targets(self) -> list[str]:
+        """The part's files of the default run (its jobs' files the run asks for)."""
+        return []
+
+    def notes(self) -> list[str]:
+        """What the console says of the part before any job."""
+        return []

@@ -5,20 +5,11 @@ registry). Made when ``figures.sweep_vs_N`` is set."""
 
 from __future__ import annotations
 
-from chain.pipeline.plan.steps import Step
+from chain.pipeline.plan.steps import Part, Step
 
 
-class SweepPlan:
-    """The sweep_table step.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class SweepPlan(Part):
+    """The sweep_table step."""
 
     def steps(self) -> list[Step]:
         """sweep_table, when the run makes the sweep's table."""
