@@ -179,7 +179,7 @@ def test_a_store_that_cannot_be_written_keeps_the_result_and_says_so(work, monke
     def no_space(*args, **kwargs):
         raise full
 
-    monkeypatch.setattr("chain.pipeline.run.store._copy_hashing", no_space)
+    monkeypatch.setattr("chain.pipeline.run.store.copy_hashing", no_space)
     p = plan("first")
     reuse = Reuse(p, work)
     reuse.prepare(p.targets)

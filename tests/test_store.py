@@ -497,9 +497,9 @@ def test_the_atomic_writers_flush_before_they_rename(tmp_path, disk_events):
 
 STOPPED = textwrap.dedent("""
     import os, signal, sys
-    from chain.pipeline.run import store as module
+    from chain.pipeline.run import store, store_files as module
     root, how, key, *outputs = sys.argv[1:]
-    check, calls = module._check_file, []
+    check, calls = module.check_file, []
 
     def stopping(*args):
         got = check(*args)
@@ -508,8 +508,8 @@ STOPPED = textwrap.dedent("""
             os.kill(os.getpid(), getattr(signal, how))
         return got
 
-    module._check_file = stopping
-    module.Store.open({"HERTZCHAIN_STORE": root}).fetch(key, outputs)
+    module.check_file = stopping
+    store.Store.open({"HERTZCHAIN_STORE": root}).fetch(key, outputs)
 """)
 
 

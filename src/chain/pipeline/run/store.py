@@ -19,23 +19,33 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import hashlib
 import json
 import os
 import re
-import shutil
-import stat
 import weakref
 from collections.abc import Iterator
 from pathlib import Path
 
-from chain.atomic import ordinary_mode, sync
+from chain.atomic import ordinary_mode
 from chain.pipeline.run.staging import (
     FOLDER_FLAGS,
-    interruptible,
     remove_at,
     remove_stale_staging,
     staging_name,
+)
+from chain.pipeline.run.store_files import (
+    CREATE,
+    BadEntry,
+    check_output,
+    copy_hashing,
+    copy_out,
+    file_digest,
+    folder_at,
+    manifest_and_size,
+    manifest_of,
+    open_regular,
+    stored_digest,
+    write_all,
 )
 from chain.pipeline.run.store_path import (
     GROUP_VARIABLE,
@@ -60,52 +70,9 @@ __all__ = [
 #: The store's folder relative to the working directory: ``rm -r results`` empties it.
 DEFAULT_FOLDER = Path("results") / ".store"
 
-_CHUNK = 1 << 20  # bytes read at a time
-# A regular file, never through a link; a FIFO put in its place does not block.
-_READ = os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC
-_CREATE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
 # What a rename onto an entry's name says when something is there already.
 _TAKEN = (errno.EEXIST, errno.ENOTEMPTY, errno.ENOTDIR, errno.EISDIR)
 _KEY = re.compile(r"[0-9a-f]{64}")
-
-
-class BadEntry(Exception):
-    """A stored entry does not match its manifest; the message says which file."""
-
-
-def file_digest(path: str | os.PathLike) -> str:
-    """SHA-256 (hex) of a file's bytes, or of a folder's files (:func:`stored_digest`)."""
-    path = Path(path)
-    if path.is_dir():
-        return _listing({name: file_digest(path / name) for name in _files_under(path)})
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        while chunk := stream.read(_CHUNK):
-            digest.update(chunk)
-    return digest.hexdigest()
-
-
-def stored_digest(files: dict) -> str:
-    """The :func:`file_digest` of a stored output, from its manifest record (name ->
-    [sha256, size]; the name "" for a file)."""
-    if list(files) == [""]:
-        return files[""][0]
-    return _listing({name: sha256 for name, (sha256, _) in files.items()})
-
-
-def _listing(digests: dict) -> str:
-    listing = [f"{name}\0{digests[name]}" for name in sorted(digests)]
-    return hashlib.sha256("\n".join(listing).encode()).hexdigest()
-
-
-def _files_under(folder: Path) -> list[str]:
-    """Every file below ``folder``, as sorted relative POSIX paths; hidden files left
-    out (Snakemake's ``.snakemake_timestamp``, an interrupted writer's temporary)."""
-    return sorted(
-        p.relative_to(folder).as_posix()
-        for p in folder.rglob("*")
-        if p.is_file() and not p.name.startswith(".")
-    )
 
 
 class Store:
@@ -209,8 +176,8 @@ class Store:
             if entry is None:
                 return None
             try:
-                manifest = _manifest(entry, len(outputs))
-                _copy_out(entry, manifest, [Path(out) for out in outputs])
+                manifest = manifest_of(entry, len(outputs))
+                copy_out(entry, manifest, [Path(out) for out in outputs])
             finally:
                 os.close(entry)
         except BadEntry:
@@ -238,13 +205,13 @@ class Store:
         if entry is None:
             return None
         try:
-            manifest = _manifest(entry, count)
-            files = _folder_at(entry, "files")
+            manifest = manifest_of(entry, count)
+            files = folder_at(entry, "files")
             try:
                 for i, record in enumerate(manifest["outputs"]):
                     paths = manifest.get("paths") or []
                     label = str(paths[i]) if i < len(paths) else f"files/{i}"
-                    _check_output(files, str(i), record, label, None)
+                    check_output(files, str(i), record, label, None)
             finally:
                 os.close(files)
         finally:
@@ -257,7 +224,7 @@ class Store:
         if entry is None:
             return None
         try:
-            return _manifest(entry, None)
+            return manifest_of(entry, None)
         except BadEntry:
             return None
         finally:
@@ -301,7 +268,7 @@ class Store:
                     os.close(files)
                 manifest = {**about, "key": key, "outputs": records}
                 text = json.dumps(manifest, indent=1).encode()
-                self._write(staging, "manifest.json", lambda out: _write_all(out, text))
+                self._write(staging, "manifest.json", lambda out: write_all(out, text))
                 os.fsync(staging)
             finally:
                 os.close(staging)
@@ -345,7 +312,7 @@ class Store:
                     keys = sorted(e.name for e in found if _KEY.fullmatch(e.name))
                 for key in keys:
                     try:
-                        found = _manifest_and_size(prefix, key)
+                        found = manifest_and_size(prefix, key)
                     except OSError:  # removed meanwhile
                         continue
                     yield key, *found
@@ -389,7 +356,7 @@ class Store:
     def _write(self, folder: int, name: str, write) -> None:
         """Make the file ``name`` in ``folder``, ``write(fd)`` it, make it read-only
         (the store's file mode) and flush it to disk."""
-        out = os.open(name, _CREATE, 0o600, dir_fd=folder)
+        out = os.open(name, CREATE, 0o600, dir_fd=folder)
         try:
             write(out)
             self._own(out, self.file_mode)
@@ -410,7 +377,7 @@ class Store:
         return record
 
     def _stage_tree(self, source: Path, folder: int, prefix: str, record: dict) -> None:
-        """Copy the files below ``source`` into ``folder`` (those :func:`_files_under`
+        """Copy the files below ``source`` into ``folder`` (those :func:`files_under`
         lists), recording each under ``prefix`` + its name; flush the folder."""
         with os.scandir(source) as found:
             entries = sorted(found, key=lambda entry: entry.name)
@@ -428,9 +395,9 @@ class Store:
     def _store_file(self, source: Path, folder: int, name: str) -> list:
         """Copy the regular file ``source`` to ``name`` in ``folder``: [sha256, size]."""
         got = []
-        read = _open_regular(None, source)
+        read = open_regular(None, source)
         try:
-            self._write(folder, name, lambda out: got.extend(_copy_hashing(read, out)))
+            self._write(folder, name, lambda out: got.extend(copy_hashing(read, out)))
         finally:
             os.close(read)
         return got
@@ -451,7 +418,7 @@ class Store:
                     os.fsync(prefix)
                     return manifest
                 try:  # stored meanwhile by another run: one entry is kept
-                    kept = _manifest_and_size(prefix, key, len(manifest["outputs"]))[0]
+                    kept = manifest_and_size(prefix, key, len(manifest["outputs"]))[0]
                 except (BadEntry, OSError):
                     kept = None
                 if kept is not None:
@@ -460,195 +427,3 @@ class Store:
         finally:
             os.close(prefix)
         raise OSError(errno.EEXIST, "a damaged entry cannot be replaced", str(self.entry(key)))
-
-
-def _manifest(entry: int, count: int | None) -> dict:
-    """The manifest of the open entry ``entry``, with ``count`` outputs (any: None)."""
-    try:
-        fd = _open_regular(entry, "manifest.json")
-        with open(fd, "rb") as stream:
-            manifest = json.loads(stream.read())
-        outputs = manifest["outputs"]
-        if count is not None and len(outputs) != count:
-            raise ValueError(f"{len(outputs)} outputs, the job has {count}")
-        if not all(
-            isinstance(files, dict) and all(len(v) == 2 for v in files.values())
-            for files in outputs
-        ):
-            raise ValueError("an output's record is not {file: [sha256, size]}")
-        return manifest
-    except (OSError, ValueError, KeyError, TypeError) as error:
-        raise BadEntry(f"manifest.json unreadable ({error})") from None
-
-
-def _manifest_and_size(prefix: int, key: str, count: int | None = None):
-    """(manifest or None if unreadable, size in bytes) of the entry ``key`` of the open
-    folder ``prefix``."""
-    entry = os.open(key, FOLDER_FLAGS, dir_fd=prefix)
-    try:
-        try:
-            manifest = _manifest(entry, count)
-        except BadEntry:
-            manifest = None
-        size = 0
-        for _, _, names, folder in os.fwalk(".", dir_fd=entry):
-            for name in names:
-                info = os.stat(name, dir_fd=folder, follow_symlinks=False)
-                size += info.st_size if stat.S_ISREG(info.st_mode) else 0
-        return manifest, size
-    finally:
-        os.close(entry)
-
-
-def _folder_at(parent: int, name: str) -> int:
-    """The descriptor of a stored folder (never through a link), or :class:`BadEntry`."""
-    try:
-        return os.open(name, FOLDER_FLAGS, dir_fd=parent)
-    except OSError as error:
-        raise BadEntry(f"{name}: {error.strerror}") from None
-
-
-def _open_regular(parent: int | None, name: str | Path) -> int:
-    """A descriptor for reading the regular file ``name`` (of ``parent``), never
-    through a link: OSError if it is gone, a link, or not a regular file."""
-    fd = os.open(name, _READ, dir_fd=parent)
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
-        os.close(fd)
-        raise OSError(errno.EINVAL, "not a regular file", os.fspath(name))
-    return fd
-
-
-def _walk(folder: int, prefix: str = "") -> Iterator[tuple[str, int, str]]:
-    """(path below the stored folder, its folder's descriptor, name) of each file below
-    the open ``folder``, sorted, never through a link (a link is listed as a file);
-    hidden files left out, as :func:`_files_under` does."""
-    with os.scandir(folder) as found:
-        entries = sorted((e.name, e.is_dir(follow_symlinks=False)) for e in found)
-    for name, is_dir in entries:
-        if is_dir:
-            sub = _folder_at(folder, name)
-            try:
-                yield from _walk(sub, f"{prefix}{name}/")
-            finally:
-                os.close(sub)
-        elif not name.startswith("."):
-            yield prefix + name, folder, name
-
-
-def _check_output(files: int, name: str, record: dict, label: str, copy: Path | None) -> None:
-    """Check the stored output ``files/<name>`` against its ``record`` (file name ->
-    [sha256, size]; "" names a stored file itself) file by file, copying it to ``copy``
-    meanwhile if given (each file flushed). Raises :class:`BadEntry` naming the file."""
-    try:
-        is_dir = stat.S_ISDIR(os.stat(name, dir_fd=files, follow_symlinks=False).st_mode)
-    except OSError as error:
-        raise BadEntry(f"{label}: {error.strerror}") from None
-    folder = _folder_at(files, name) if is_dir else None
-    try:
-        if copy is not None and is_dir:
-            copy.mkdir()
-        seen = set()
-        for path, parent, leaf in _walk(folder) if is_dir else [("", files, name)]:
-            shown = f"{label}/{path}" if path else label
-            if path not in record:
-                raise BadEntry(f"{shown}: a file the manifest does not list")
-            got = _check_file(parent, leaf, None if copy is None else copy / path, shown)
-            sha256, size = record[path]
-            if got != (sha256, size):
-                raise BadEntry(
-                    f"{shown}: SHA-256 {got[0][:12]}... ({got[1]} bytes), stored as "
-                    f"{str(sha256)[:12]}... ({size} bytes)"
-                )
-            seen.add(path)
-        if set(record) - seen:
-            raise BadEntry(f"{label}: {sorted(set(record) - seen)} missing")
-    finally:
-        if folder is not None:
-            os.close(folder)
-
-
-def _check_file(parent: int, name: str, copy: Path | None, shown: str) -> tuple[str, int]:
-    """(SHA-256, size) of the stored file ``name`` of ``parent``, copied to ``copy``
-    (made, flushed) if given."""
-    try:
-        read = _open_regular(parent, name)
-    except OSError as error:  # gone, or a link put in its place
-        raise BadEntry(f"{shown}: {error.strerror}") from None
-    try:
-        if copy is None:
-            return _copy_hashing(read, None)
-        copy.parent.mkdir(parents=True, exist_ok=True)
-        out = os.open(copy, _CREATE, 0o666)  # a copy of the user's, as the umask allows
-        try:
-            got = _copy_hashing(read, out)
-            os.fsync(out)
-        finally:
-            os.close(out)
-        return got
-    finally:
-        os.close(read)
-
-
-def _copy_hashing(source: int, target: int | None) -> tuple[str, int]:
-    """Read the open file ``source`` to its end, writing it to ``target`` if given;
-    the bytes' (SHA-256, size)."""
-    digest, size = hashlib.sha256(), 0
-    while chunk := os.read(source, _CHUNK):
-        digest.update(chunk)
-        size += len(chunk)
-        if target is not None:
-            _write_all(target, chunk)
-    return digest.hexdigest(), size
-
-
-def _write_all(fd: int, data: bytes) -> None:
-    view = memoryview(data)
-    while view:
-        view = view[os.write(fd, view) :]
-
-
-def _copy_out(entry: int, manifest: dict, outputs: list[Path]) -> None:
-    """Copy the open entry's outputs to ``outputs``: staged beside each (what a killed
-    fetch left there removed first), checked, then renamed into place."""
-    for folder in {out.parent for out in outputs}:
-        folder.mkdir(parents=True, exist_ok=True)
-        remove_stale_staging(folder)
-    copies: list[Path] = []
-    with interruptible():
-        try:
-            files = _folder_at(entry, "files")
-            try:
-                for i, (out, record) in enumerate(zip(outputs, manifest["outputs"])):
-                    copies.append(out.parent / staging_name())
-                    _check_output(files, str(i), record, out.name, copies[-1])
-            finally:
-                os.close(files)
-            for copy, out in zip(copies, outputs):
-                _into_place(copy, out)
-        except BaseException:
-            for copy in copies:
-                _remove(copy)
-            raise
-
-
-def _into_place(copy: Path, out: Path) -> None:
-    """Rename the checked ``copy`` to ``out``, flushing what it holds first. A file
-    replaces a file at once; a folder in the way is renamed aside and deleted after."""
-    if copy.is_dir():
-        for folder, _, _ in os.walk(copy, topdown=False):
-            sync(folder, directory=True)
-    if (out.is_dir() and not out.is_symlink()) or (copy.is_dir() and os.path.lexists(out)):
-        old = out.parent / staging_name()
-        os.rename(out, old)
-        os.rename(copy, out)
-        _remove(old)
-    else:
-        os.replace(copy, out)
-    sync(out.parent, directory=True)
-
-
-def _remove(path: Path) -> None:
-    if path.is_dir() and not path.is_symlink():
-        shutil.rmtree(path, ignore_errors=True)
-    else:
-        path.unlink(missing_ok=True)
