@@ -224,3 +224,23 @@ def test_another_release_is_left_as_it_is_and_said_so_in_one_line():
     assert "stay off" in lines[0] and "wake-up timers multiply" in lines[0]
     assert "SIGTERM" in lines[0] and "docs/upstream/README.md" in lines[0]
     assert (ROOT / "docs" / "upstream" / "README.md").is_file()
+
+
+def test_the_workflow_attributes_reuse_reads_are_the_locked_snakemakes():
+    """The store's part before the first job (common.smk's prepare_run) reads public
+    attributes of Snakemake's workflow object: whether this process runs the workflow,
+    whether it is a dry run or --touch, and the DAG settings (targets, --forceall ...)."""
+    import snakemake.api  # noqa: F401 (snakemake.workflow imports itself through it)
+    from snakemake.settings.types import DAGSettings
+    from snakemake.workflow import Workflow
+
+    for name in ("is_main_process", "executor_plugin", "dryrun", "touch"):
+        assert isinstance(inspect.getattr_static(Workflow, name), property), name
+    assert "self.dag_settings" in inspect.getsource(Workflow)
+    for field in ("targets", "forceall", "forcerun", "forcetargets"):
+        assert field in DAGSettings.__dataclass_fields__, field
+    # The DAG is built, and the input functions called, only after the executor is set.
+    execute = inspect.getsource(Workflow.execute)
+    assert execute.index("self._executor_plugin = executor_plugin") < execute.index(
+        "self._build_dag()"
+    )
