@@ -137,10 +137,10 @@ class Reuse:
         settled, lines, present, pending = set(), [], 0, self._pending()
         for job in self.needed:
             outputs = list(job.outputs.values())
-            for path in outputs:  # a link is never taken for a result
+            for path in outputs if not dry else ():  # a link is never taken for a result
                 if os.path.islink(path):
                     os.unlink(path)
-            if all(os.path.exists(p) for p in outputs):
+            if all(os.path.exists(p) and not os.path.islink(p) for p in outputs):
                 settled.add(id(job))
                 present += 1
                 if not dry and pending.get(str(job)) == self.key(job):
