@@ -38,7 +38,3 @@ rule all:
 
 include: "workflow/rules/targets.smk"
 include: "workflow/rules/steps.smk"
-
-
-# The import statements every rule's code() read, for the next command (common.smk).
-save_imports(IMPORTS_STORE)

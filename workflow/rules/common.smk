@@ -29,7 +29,7 @@ check_config(config)
 # reruns the simulations, and one figure's module redraws that figure only. Paths
 # relative to the working directory: a moved or copied checkout has nothing to do.
 # PACKAGE_DIR is the package the jobs import (src/chain, or PYTHONPATH's copy). The
-# import statements are remembered by file version between commands.
+# import statements are remembered by file version between runs (prepare_run).
 PACKAGE_DIR = Path(importlib.util.find_spec("chain").origin).parent
 IMPORTS_STORE = DEFAULT_CACHE.parent / "imports.json"
 remember_imports(IMPORTS_STORE)
@@ -93,6 +93,8 @@ def prepare_run():
     targets = PLAN.target_files(asked.targets)
     for line in REUSE.prepare(targets, dry=workflow.dryrun, forced=forced):
         print(line, flush=True)
+    if not workflow.dryrun:  # the import statements code() read, for the next command
+        save_imports(IMPORTS_STORE)
 
 
 def job_inputs(rule):
