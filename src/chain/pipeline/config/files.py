@@ -1,19 +1,17 @@
 """The pipeline's config files as text: YAML mistakes named by file and line.
 
 Snakemake reports a config file it cannot parse as "Config file is not valid JSON or
-YAML", without the file or the line, and a key given twice silently keeps the last
-value. :func:`check_config_files` reads the files before Snakemake does (the main
-``config.yaml``) or again after it (the ``--configfile`` overlays, which Snakemake
-parses before the Snakefile runs) and names both.
-
-An overlay that is not valid YAML at all stops Snakemake before the Snakefile runs, with
-Snakemake's own message (``--verbose`` shows the parser's, with file and line);
-``python -m chain.pipeline.config.files whatif/x.yaml`` names them too.
+YAML", without file or line, and a key given twice silently keeps the last value.
+:func:`check_config_files` reads the files before Snakemake does (``config.yaml``) or
+again after it (the ``--configfile`` overlays) and names both. An overlay that is not
+YAML at all stops Snakemake before the Snakefile runs, with Snakemake's own message;
+``python -m chain.pipeline.config.files whatif/x.yaml`` names file and line.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -43,12 +41,13 @@ class _StrictLoader(yaml.SafeLoader):
 
 
 def check_config_file(path: str | os.PathLike) -> None:
-    """Parse one config file; raise :class:`ConfigError` naming the file and line.
+    """Parse one config file (YAML or JSON, the main one or an overlay); raise
+    :class:`ConfigError` naming the file and line of a mistake.
 
     Parameters
     ----------
     path : path
-        A YAML (or JSON) config file, the main one or an overlay.
+        The config file.
     """
     try:
         text = Path(path).read_text(encoding="utf-8")
@@ -70,18 +69,14 @@ def check_config_file(path: str | os.PathLike) -> None:
 
 
 def check_config_files(paths: Iterable[str | os.PathLike]) -> None:
-    """:func:`check_config_file` on each of ``paths`` (missing optional files skipped
-    by the caller)."""
+    """:func:`check_config_file` on each of ``paths`` (config files)."""
     for path in paths:
         check_config_file(path)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m chain.pipeline.config.files FILE...``: name the file and line of a YAML
-    mistake in config files (Snakemake parses ``--configfile`` overlays before the
-    Snakefile runs, and its own message names neither)."""
-    import sys
-
+    """``python -m chain.pipeline.config.files FILE...``: name the file and line of each
+    YAML mistake in the config files ``argv`` (default the command line's); 1 if any."""
     status = 0
     for path in sys.argv[1:] if argv is None else argv:
         try:
