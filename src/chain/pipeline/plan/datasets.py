@@ -1,22 +1,13 @@
 """The experiment's parts (chains and their datasets) and labels, and the measured
 datasets a config uses, checked before any job runs.
 
-:func:`experiment_parts` gives the chains of the experiment (one per configured chain
-for the virtual experiment, one per dataset folder for measured data, read from its
-``metadata.yaml``) and :func:`experiment_label` how figures and the summary name them.
-
-:func:`check_experiment_datasets` runs :func:`chain.apparatus.dataset_check.check_dataset`
-on every dataset folder of ``experiment.datasets`` when the pipeline builds its DAG, and
-stops with one :class:`~chain.errors.ConfigError` that lists every problem of
-every dataset (up to a limit each), one console line per problem: file, line, column,
-what was expected. Shots with a dead or saturated channel stop the run too, unless
-``experiment.bad_channels: skip``; then :func:`skipped_shot_rows` gives the rows that
-``experiment/selection.csv`` lists them with (kept False, the channel as the reason),
-so the summary counts them among the rejected shots.
-
-The check's verdicts are kept in :data:`DEFAULT_CACHE`, a folder named by a digest of
-the code that makes them (:func:`check_code_digest`): an edit of that code starts an
-empty folder, and the check's code needs no version to bump.
+:func:`check_experiment_datasets` checks every shot file of ``experiment.datasets`` as
+the pipeline builds its DAG and stops with one :class:`~chain.errors.ConfigError` listing
+every problem (file, line, column, what was expected). With ``experiment.bad_channels:
+skip``, shots with a dead or saturated channel are left out instead, and listed as
+rejected in ``experiment/selection.csv`` (:func:`skipped_shot_rows`). The check's
+verdicts are cached in a folder named by a digest of its code (:data:`DEFAULT_CACHE`):
+an edit of that code starts an empty one.
 """
 
 from __future__ import annotations
@@ -35,8 +26,8 @@ from chain.analysis.selection import SELECTION_COLUMNS
 from chain.apparatus.dataset_check import DatasetCheck, check_dataset
 from chain.apparatus.measured import MeasuredDataError, read_metadata, usable_shots
 from chain.errors import ConfigError
-from chain.errors import key_label as key_name
 from chain.labels import SKIPPED_REASON, VIRTUAL_LABEL, VIRTUAL_SERIES
+from chain.pipeline.config import fail
 from chain.pipeline.plan.code import module_sources
 
 #: The module whose verdicts are cached, and the package it is in.
@@ -68,37 +59,21 @@ DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / f"dataset-check-{check_code_
 SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
 
-def _fail(path, message: str):
-    raise ConfigError(f"config key {key_name(path)!r}: {message}")
-
-
 @dataclass(frozen=True)
 class ExperimentPart:
-    """One chain of the experiment: where its traces come from.
+    """One chain of the experiment: where its traces come from."""
 
-    Attributes
-    ----------
-    name : str
-        Series name (the ``model`` column; chains of one name are pooled in the fits).
-    n_beads : int
-        N.
-    sensor_beads : tuple of int
-        Sensor beads, S1 first.
-    folder : str or None
-        The measured dataset folder; None for the virtual experiment (its folder is a
-        pipeline output).
-    files : tuple of str
-        ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
-    virtual : bool
-        Whether the traces come from the virtual experiment (a model, not data),
-        including a measured-format dataset that it wrote.
-    """
-
+    #: Series name (the ``model`` column; chains of one name are pooled in the fits).
     name: str
     n_beads: int
+    #: Sensor beads, S1 first.
     sensor_beads: tuple[int, ...]
+    #: The measured dataset folder; None for the virtual experiment (a pipeline output).
     folder: str | None = None
+    #: ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
     files: tuple[str, ...] = ()
+    #: Whether the traces come from the virtual experiment (a model, not data), a
+    #: measured-format dataset that it wrote included.
     virtual: bool = True
 
 
@@ -115,15 +90,10 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
     Returns
     -------
     list of ExperimentPart
-        Empty with ``experiment.source: none``; one per configured chain for the
-        virtual experiment; one per dataset for measured datasets.
-
-    Raises
-    ------
-    ConfigError
-        Naming ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong
-        (the loader's message, with file and line), its name is not usable in file
-        names, or two datasets give the same name and N.
+        Empty with ``experiment.source: none``; one per configured chain for the virtual
+        experiment; one per dataset for measured datasets. ConfigError naming
+        ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong, its
+        name unusable in file names, or its name and N those of another.
     """
     experiment = config.get("experiment", {})
     source = experiment.get("source", "none")
@@ -143,10 +113,10 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
         try:
             meta = read_metadata(where)
         except MeasuredDataError as error:
-            _fail(path, f"{error}")
+            fail(path, f"{error}")
         series = name or meta.name or where.resolve().name
         if not SERIES_NAME.match(series):
-            _fail(
+            fail(
                 path,
                 f"dataset name {series!r} (metadata name, else folder name) is not usable "
                 "in file names; allowed: letters, digits, '_', '-', starting with a "
@@ -154,36 +124,31 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
             )
         key = (series, meta.n_beads)
         if key in seen:
-            _fail(
+            fail(
                 path,
                 f"gives the series {series!r} with N = {meta.n_beads} again (as "
                 f"experiment.datasets[{seen[key]}]); allowed: one dataset per name and N",
             )
         seen[key] = i
+        files = ("metadata.yaml", *(shot.file for shot in meta.shots))
         parts.append(
             ExperimentPart(
-                name=series,
-                n_beads=meta.n_beads,
-                sensor_beads=tuple(meta.sensor_beads),
-                folder=str(folder),
-                files=(
-                    str(Path(folder) / "metadata.yaml"),
-                    *(str(Path(folder) / shot.file) for shot in meta.shots),
-                ),
-                virtual=VIRTUAL_LABEL in (meta.description or ""),
+                series,
+                meta.n_beads,
+                tuple(meta.sensor_beads),
+                str(folder),
+                tuple(str(Path(folder) / file) for file in files),
+                VIRTUAL_LABEL in (meta.description or ""),
             )
         )
     return parts
 
 
 def experiment_label(parts: Sequence[ExperimentPart]) -> str:
-    """How figures and the summary name the experiment series.
-
-    ``"virtual experiment (model)"`` for the virtual experiment run by the pipeline;
-    ``"measured (<names>)"`` for measured datasets, and ``"virtual experiment (model):
-    <names>"`` for a measured-format dataset that the virtual experiment wrote (it is
-    still not data).
-    """
+    """How figures and the summary name the experiment series of ``parts``
+    (:func:`experiment_parts`): ``"virtual experiment (model)"``, ``"measured
+    (<names>)"``, or ``"virtual experiment (model): <names>"`` for a measured-format
+    dataset that the virtual experiment wrote (still not data)."""
     if not parts:
         return "experiment"
     if all(part.folder is None for part in parts):
@@ -212,38 +177,29 @@ def check_experiment_datasets(
     config : mapping
         A config that passed :func:`chain.pipeline.config.check.check_config`.
     parts : sequence of ExperimentPart
-        :func:`experiment_parts` of it (virtual parts, whose
-        datasets are pipeline outputs, are skipped).
+        :func:`experiment_parts` of it (virtual parts, pipeline outputs, are skipped).
     root : path
         Folder that relative dataset paths start from.
     cache_dir : path or None
         Verdict cache (relative paths start from ``root``), made private (0700); the
-        folders beside it named ``dataset-check*`` (verdicts of other versions of the
-        check's code) are removed. None checks every file.
-
-    Raises
-    ------
-    ConfigError
-        ``experiment.datasets: N problems in M datasets`` then one line per problem.
+        folders beside it named ``dataset-check*`` (other versions of the check's code)
+        are removed. None checks every file.
     """
     policy = bad_channel_policy(config)
     cache = None if cache_dir is None else Path(root) / cache_dir
     for old in [] if cache is None else cache.parent.glob("dataset-check*"):
         if old != cache and old.is_dir():
             shutil.rmtree(old, ignore_errors=True)
-    messages, bad = [], 0
+    messages = []
     for part in parts:
-        if part.folder is None:
-            continue
-        folder = Path(part.folder)
         try:
-            usable_shots(check_dataset(Path(root) / folder, cache_dir=cache), policy)
+            if part.folder is not None:
+                usable_shots(check_dataset(Path(root) / part.folder, cache_dir=cache), policy)
         except MeasuredDataError as error:
             messages.append(str(error))
-            bad += 1
     if messages:
         raise ConfigError(
-            f"config key 'experiment.datasets': {bad} of {len(parts)} datasets cannot be "
+            f"config key 'experiment.datasets': {len(messages)} of {len(parts)} datasets cannot be "
             "used (data/README.md; every problem below, up to 20 per dataset):\n"
             + "\n".join(messages)
         )
