@@ -1,10 +1,9 @@
 """Headline numbers of a run, compared with a committed reference (what CI checks).
 
-The headline numbers are read from a run's ``summary.json`` (results contract): the
-ballistic constants C_bal, the fitted C of Delta = C F_m^(-1/6) and the free exponent
-per source, model, N and estimator, the SSW slopes, and the largest energy drift of
-the conservative runs. A reference file holds the same numbers with the tolerance of
-each kind; it changes only in a reviewed commit that says why.
+From a run's ``summary.json``: the ballistic constants C_bal, C of Delta = C F_m^(-1/6)
+and the free exponent per source, model, N and estimator, the SSW slopes, and the
+largest energy drift of the conservative runs. The reference file holds them with each
+kind's tolerance; it changes only in a reviewed commit that says why.
 """
 
 from __future__ import annotations
@@ -19,7 +18,8 @@ from chain.analysis.ssw_fits import SSW_FIT_COLUMNS
 from chain.analysis.ssw_speed import SPEED_COLUMNS
 from chain.analysis.ssw_track import TRACK_COLUMNS
 
-#: Files of the results contract (design.md), relative to results/<run_name>/.
+#: Files of the results contract (design.md) in results/<run_name>/: the figures (Fig. 2
+#: with an experiment), and the contract columns of each table (more follow them).
 CONTRACT_FIGURES = (
     "fig1_setup",
     "fig3_simulation_traces",
@@ -28,7 +28,6 @@ CONTRACT_FIGURES = (
     "ssw_spacetime",
 )
 EXPERIMENT_FIGURES = ("fig2_experiment_traces",)
-#: Contract columns of each table (the tables have more after these).
 CONTRACT_TABLES = {
     "pulses.csv": (),
     "delays.csv": ("source", "model", "N", "F_m_N", "delay_us"),
@@ -67,7 +66,7 @@ DEFAULT_TOLERANCES = {
 
 
 def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = True) -> list[str]:
-    """Contract files absent from ``run_folder`` or lacking their columns / keys.
+    """Contract files absent from ``run_folder``, empty, or lacking their columns / keys.
 
     Parameters
     ----------
@@ -80,10 +79,8 @@ def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = Tru
 
     folder = Path(run_folder)
     problems = []
-    figures = CONTRACT_FIGURES + (EXPERIMENT_FIGURES if experiment else ())
-    for name in figures:
-        for suffix in (".pdf", ".png"):
-            path = folder / "figures" / f"{name}{suffix}"
+    for name in CONTRACT_FIGURES + (EXPERIMENT_FIGURES if experiment else ()):
+        for path in (folder / "figures" / f"{name}.pdf", folder / "figures" / f"{name}.png"):
             if not path.is_file() or path.stat().st_size == 0:
                 problems.append(f"{path}: missing or empty")
     for name, columns in CONTRACT_TABLES.items():
@@ -92,25 +89,21 @@ def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = Tru
             problems.append(f"{path}: missing")
             continue
         header = list(pd.read_csv(path, nrows=0).columns)
-        absent = [c for c in columns if c not in header]
-        if absent:
+        if absent := [c for c in columns if c not in header]:
             problems.append(f"{path}: missing columns {absent}")
     for name in ("summary.json", "summary.md", "article.pdf"):
         if not (folder / name).is_file():
             problems.append(f"{folder / name}: missing")
-    if (folder / "summary.json").is_file():
-        summary = json.loads((folder / "summary.json").read_text())
-        absent = [k for k in SUMMARY_KEYS if k not in summary]
-        if absent:
-            problems.append(f"{folder / 'summary.json'}: missing keys {absent}")
+    if (path := folder / "summary.json").is_file():
+        summary = json.loads(path.read_text())
+        if absent := [k for k in SUMMARY_KEYS if k not in summary]:
+            problems.append(f"{path}: missing keys {absent}")
     return problems
 
 
 def headline_numbers(summary: dict) -> dict[str, float]:
-    """Flatten the headline numbers of a ``summary.json`` into {name: value}.
-
-    Names look like ``C_us_N16/simulation/elastic/N=25/fit_full`` so that a failing
-    check reads on its own.
+    """Flatten the headline numbers of a ``summary.json`` into {name: value}, names such
+    as ``C_us_N16/simulation/elastic/N=25/fit_full`` (a failing check reads on its own).
 
     Parameters
     ----------
