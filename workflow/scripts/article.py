@@ -10,9 +10,7 @@ log = start(snakemake)
 with open(snakemake.input.summary, encoding="utf-8") as stream:
     summary = json.load(stream)
 numbers = article_numbers(
-    summary,
-    setup=snakemake.params.setup,
-    provenance=snakemake.params.provenance,
+    summary, setup=snakemake.params.setup, provenance=snakemake.params.provenance
 )
 compile_article(snakemake.input.source, numbers, snakemake.input.figures, snakemake.output[0])
 log.info("claims: %s", [(c["claim"], c["agrees"]) for c in numbers["claims"]])

@@ -24,14 +24,7 @@ for job in p.jobs:
     )
     log.info("eta = %g s, N = %d, beads %s simulated", job["eta_s"], job["N"], job["sensors"])
 table = c_sensitivity_every_estimator(traces, p.plan)
-for row in table[table["N"].astype(str) == "pooled"].itertuples():
-    log.info(
-        "headline %s; %s = %s: C = %.2f +- %.2f, p = %.4f",
-        row.main_estimator,
-        row.choice,
-        row.value,
-        row.C,
-        row.C_stderr,
-        row.exponent,
-    )
+columns = ["main_estimator", "choice", "value", "C", "C_stderr", "exponent"]
+for row in table[table["N"].astype(str) == "pooled"][columns].itertuples(index=False):
+    log.info("headline %s; %s = %s: C = %.2f +- %.2f, p = %.4f", *row)
 write_csv_atomic(table, snakemake.output[0])

@@ -18,13 +18,10 @@ for dataset, folder, traces in zip(datasets, dataset_folders(snakemake), snakema
     if set(table["N"]) != {dataset["N"]}:
         raise ValueError(f"{folder}: N = {sorted(set(table['N']))}, expected {dataset['N']}")
     shots = table.drop_duplicates("shot")
+    counts = [int((shots["kind"] == kind).sum()) for kind in ("collision", "reference")]
     log.info(
         "%s -> %s: %d collision and %d reference shots, %d amplitudes",
-        folder,
-        traces,
-        int((shots["kind"] == "collision").sum()),
-        int((shots["kind"] == "reference").sum()),
-        shots["amplitude"].nunique(),
+        *(folder, traces, *counts, shots["amplitude"].nunique()),
     )
     write_traces(table, traces)  # atomic: temporary file, then rename
 log.info("done")

@@ -1,7 +1,5 @@
 """Fig. 4: |Delta| against F_m (chain.report.figures.fig4_delay_vs_force)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -18,5 +16,5 @@ fig = fig4_delay_vs_force(
     estimator=p.estimator,
     experiment_label=p.experiment_label,
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")
