@@ -162,15 +162,10 @@ def _check_tolerance(config: Mapping, settings) -> None:
 
 
 def check_experiment_bounds(config: Mapping) -> None:
-    """The virtual experiment's bounds that need two keys (see the module docstring);
-    :class:`~chain.errors.ConfigError` naming the first offending key.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config with ``experiment.source: virtual`` that passed the
-        checks of :func:`chain.pipeline.config.check.check_config` before the bounds.
-    """
+    """The virtual experiment's bounds that need two keys (module docstring) in
+    ``config``, a schema-valid config with ``experiment.source: virtual`` that passed the
+    checks before the bounds; :class:`~chain.errors.ConfigError` naming the first
+    offending key."""
     virtual = config["experiment"]["virtual"]
     ratios = launch_ratios(config, virtual)
     for entry in config["chains"]:

@@ -21,7 +21,7 @@ from chain.physics.theory import (
     pulse_half_width,
 )
 from chain.pipeline.config import fail
-from chain.pipeline.config.check import slowest_passing
+from chain.pipeline.config.check import check_samples, slowest_passing
 from chain.studies.mechanism_settings import setting_name, sweep_settings, viscous_name
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
@@ -169,12 +169,7 @@ def _check_lammps(config: Mapping) -> None:
     fastest = LAUNCH_VELOCITY_RATIO * max(speeds)
     check_resolution(config, path, record, fastest, f"bead 1 at {max(speeds):g} m/s")
     duration = options["duration_s"]
-    if duration < 10 * record:
-        fail(
-            ["lammps", "duration_s"],
-            f"{duration:g} s holds fewer than 10 samples of lammps.record_interval_s = "
-            f"{record:g} s; allowed: >= {10 * record:g} s",
-        )
+    check_samples(["lammps", "duration_s"], duration, record, "lammps.record_interval_s")
     check_passing(config, ["lammps", "duration_s"], duration, min(speeds), "bead 1 launched")
 
 
@@ -213,15 +208,9 @@ def _check_setting_names(config: Mapping) -> None:
 
 
 def check_run_bounds(config: Mapping) -> None:
-    """The bounds of the simulated run that need two keys (see the module docstring);
-    :class:`~chain.errors.ConfigError` naming the first offending key.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in) that passed the checks of
-        :func:`chain.pipeline.config.check.check_config` before the bounds.
-    """
+    """The bounds of the simulated run that need two keys (module docstring) in
+    ``config``, a schema-valid config that passed the checks before the bounds;
+    :class:`~chain.errors.ConfigError` naming the first offending key."""
     _check_sensors(config)
     _check_simulation(config)
     _check_long_chains(config)

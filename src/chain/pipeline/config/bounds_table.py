@@ -219,13 +219,8 @@ def _unit(key: str, kind: str) -> str:
 
 
 def table_rows(schema: Mapping) -> list[tuple[str, str, str, str, str, str]]:
-    """(key, unit, type, smallest, largest, rule) of every leaf key of the schema.
-
-    Parameters
-    ----------
-    schema : mapping
-        The parsed ``workflow/schemas/config.schema.yaml``.
-    """
+    """(key, unit, type, smallest, largest, rule) of every leaf key of ``schema``, the
+    parsed ``workflow/schemas/config.schema.yaml``."""
     rows = []
     for key, sub in _leaves(schema):
         kind = sub.get("type", "as experiment.virtual" if "$ref" in sub else "")
@@ -244,13 +239,8 @@ def table_rows(schema: Mapping) -> list[tuple[str, str, str, str, str, str]]:
 
 
 def bounds_table(schema: Mapping) -> str:
-    """docs/config_bounds.md, from the schema and :data:`RULES` (:func:`table_rows`).
-
-    Parameters
-    ----------
-    schema : mapping
-        The parsed ``workflow/schemas/config.schema.yaml``.
-    """
+    """docs/config_bounds.md, from ``schema`` (the parsed config schema) and
+    :data:`RULES` (:func:`table_rows`)."""
     lines = [
         "# Config bounds",
         "",

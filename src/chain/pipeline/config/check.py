@@ -22,11 +22,7 @@ from collections.abc import Mapping
 
 from chain.errors import ConfigError, ParameterError, key_label, nonfinite_paths
 from chain.physics.materials import MATERIALS, get_material
-from chain.physics.theory import (
-    LAUNCH_VELOCITY_RATIO,
-    force_from_bead_velocity,
-    pulse_passing_time,
-)
+from chain.physics.theory import LAUNCH_VELOCITY_RATIO, force_from_bead_velocity, pulse_passing_time
 from chain.pipeline.config import fail
 from chain.pipeline.config.ablation import check_ablation
 from chain.pipeline.config.virtual import virtual_experiment
@@ -40,20 +36,33 @@ def slowest_passing(config: Mapping, v0: float, sensors=None) -> dict:
     """:func:`chain.physics.theory.pulse_passing_time` and ``N`` of the chain whose far
     sensor the wave of bead 1 launched at ``v0`` (m/s) passes last (``sensors``: chain
     entry -> its sensor beads; default the entry's ``sensors``)."""
-    return max(
-        (
-            pulse_passing_time(
-                config["material"],
-                config["radius_m"],
-                entry["N"],
-                sensors(entry) if sensors else entry["sensors"],
-                v0,
-            )
-            | {"N": entry["N"]}
-            for entry in config["chains"]
-        ),
-        key=lambda passing: passing["time_s"],
-    )
+
+    def passing(entry: Mapping) -> dict:
+        beads = sensors(entry) if sensors else entry["sensors"]
+        found = pulse_passing_time(config["material"], config["radius_m"], entry["N"], beads, v0)
+        return found | {"N": entry["N"]}
+
+    return max(map(passing, config["chains"]), key=lambda found: found["time_s"])
+
+
+def check_samples(path, duration: float, interval: float, interval_key: str) -> None:
+    """``duration`` (s) holds at least 10 samples of ``interval`` (s), the key named."""
+    if duration < 10 * interval:
+        fail(
+            path,
+            f"{duration:g} s holds fewer than 10 samples of {interval_key} = {interval:g} s; "
+            f"allowed: >= {10 * interval:g} s",
+        )
+
+
+def _check_step(path, step, interval: float, interval_key: str) -> None:
+    if step is not None and step > interval:
+        what = interval_key.removesuffix("_s").replace("_", " ")
+        fail(
+            path,
+            f"{step:g} s is longer than {interval_key} = {interval:g} s; allowed: <= the {what}, "
+            "or null",
+        )
 
 
 def launch_ratios(config: Mapping, virtual: Mapping) -> tuple[float, float]:
@@ -72,9 +81,8 @@ def launch_ratios(config: Mapping, virtual: Mapping) -> tuple[float, float]:
     if virtual.get("launch", "striker") == "bead":
         return LAUNCH_VELOCITY_RATIO, LAUNCH_VELOCITY_RATIO
     mass_ratio = (config["setup"]["striker_radius_m"] / config["radius_m"]) ** 3
-    return LAUNCH_VELOCITY_RATIO * mass_ratio, LAUNCH_VELOCITY_RATIO * 2.0 * mass_ratio / (
-        1.0 + mass_ratio
-    )
+    most = LAUNCH_VELOCITY_RATIO * 2.0 * mass_ratio / (1.0 + mass_ratio)
+    return LAUNCH_VELOCITY_RATIO * mass_ratio, most
 
 
 def _check_sources(experiment: Mapping) -> None:
@@ -100,21 +108,10 @@ def _check_virtual_keys(virtual: Mapping, base: list) -> None:
             [*base, "drop_heights_m"],
             "give impact_speeds_m_s or drop_heights_m, not both (set the other to null)",
         )
-    duration = virtual.get("duration_s", 0.0)
     sampling = virtual.get("sampling_interval_s", 1.0)
-    if duration < 10 * sampling:
-        fail(
-            [*base, "duration_s"],
-            f"{duration:g} s holds fewer than 10 samples of sampling_interval_s = {sampling:g} s; "
-            f"allowed: >= {10 * sampling:g} s",
-        )
-    step = virtual.get("time_step_s")
-    if step is not None and step > sampling:
-        fail(
-            [*base, "time_step_s"],
-            f"{step:g} s is longer than sampling_interval_s = {sampling:g} s; allowed: "
-            "<= the sampling interval, or null",
-        )
+    key = "sampling_interval_s"
+    check_samples([*base, "duration_s"], virtual.get("duration_s", 0.0), sampling, key)
+    _check_step([*base, "time_step_s"], virtual.get("time_step_s"), sampling, key)
 
 
 def _check_virtual(config: Mapping) -> None:
@@ -148,17 +145,9 @@ def _check_experiment(config: Mapping) -> None:
 
 
 def check_finite(config: Mapping) -> None:
-    """Every number of a config is finite, or :class:`ConfigError` naming each key.
-
-    One walk over the whole config rather than a rule per key: the JSON schema's
-    minimum/maximum let NaN through (comparisons with NaN are false), and YAML spells
-    NaN and infinity ``.nan`` and ``.inf``.
-
-    Parameters
-    ----------
-    config : mapping
-        A config, validated or not.
-    """
+    """Every number of ``config`` (a mapping, validated or not) is finite, else
+    :class:`ConfigError` naming each key: the schema's minimum/maximum let NaN through,
+    and YAML spells NaN and infinity ``.nan`` and ``.inf``."""
     bad = [
         f"config key {key_label(path)!r}: {number!r} is not a finite number; allowed: a "
         "finite number in the key's range (workflow/schemas/config.schema.yaml)"
@@ -226,22 +215,13 @@ def _check_models_and_launch(config: Mapping) -> list[str]:
 
 def _check_simulation(config: Mapping) -> None:
     simulation = config.get("simulation", {})
-    step = simulation.get("time_step_s")
-    record = simulation.get("record_interval_s")
-    if step is not None and record is not None and step > record:
-        fail(
-            ["simulation", "time_step_s"],
-            f"{step:g} s is longer than record_interval_s = {record:g} s; allowed: <= the "
-            "record interval, or null",
-        )
-    duration = simulation.get("duration_s")
+    record, duration = simulation.get("record_interval_s"), simulation.get("duration_s")
     path = ["simulation", "duration_s"]
-    if duration is not None and record is not None and duration < 10 * record:
-        fail(
-            path,
-            f"{duration:g} s holds fewer than 10 samples of record_interval_s = {record:g} s; "
-            f"allowed: >= {10 * record:g} s",
-        )
+    if record is not None:
+        step = simulation.get("time_step_s")
+        _check_step(["simulation", "time_step_s"], step, record, "record_interval_s")
+        if duration is not None:
+            check_samples(path, duration, record, "record_interval_s")
     if duration is None:
         return
     v0 = config["launch"]["v0_min_m_s"]
@@ -289,18 +269,9 @@ def _check_analysis_and_figures(config: Mapping, names: list[str], seen_n) -> No
 
 
 def check_config(config: Mapping) -> None:
-    """Check a schema-valid config: every number finite, then the relations between keys.
-
-    Parameters
-    ----------
-    config : mapping
-        The config after schema validation (defaults filled in).
-
-    Raises
-    ------
-    ConfigError
-        Naming every non-finite key, else the first offending key.
-    """
+    """Check ``config``, validated by the schema (defaults filled in): every number
+    finite, then the relations between keys; :class:`ConfigError` naming every
+    non-finite key, else the first offending key."""
     check_finite(config)
     if config["material"] not in MATERIALS:
         known = ", ".join(sorted(MATERIALS))
@@ -310,7 +281,7 @@ def check_config(config: Mapping) -> None:
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
-    from chain.pipeline.config.bounds import check_bounds
-
     check_ablation(config)
-    check_bounds(config, check_config)  # chain.pipeline.config.bounds: bounds needing 2 keys
+    from chain.pipeline.config.bounds import check_bounds  # imports this module
+
+    check_bounds(config, check_config)

@@ -41,14 +41,8 @@ class _StrictLoader(yaml.SafeLoader):
 
 
 def check_config_file(path: str | os.PathLike) -> None:
-    """Parse one config file (YAML or JSON, the main one or an overlay); raise
-    :class:`ConfigError` naming the file and line of a mistake.
-
-    Parameters
-    ----------
-    path : path
-        The config file.
-    """
+    """Parse the config file ``path`` (YAML or JSON, the main one or an overlay); raise
+    :class:`ConfigError` naming the file and line of a mistake."""
     try:
         text = Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:

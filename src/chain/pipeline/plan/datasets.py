@@ -36,14 +36,9 @@ PACKAGE_DIR = Path(__file__).resolve().parents[2]
 
 
 def check_code_digest(package_dir: str | os.PathLike = PACKAGE_DIR) -> str:
-    """SHA-256 (hex) of the code of the dataset check: every file of the package that
-    importing :data:`CHECK_MODULE` runs, each with its path in the package.
-
-    Parameters
-    ----------
-    package_dir : path
-        The ``chain`` package folder (by default this one's).
-    """
+    """SHA-256 (hex) of the code of the dataset check: every file of the package
+    ``package_dir`` (the ``chain`` folder) that importing :data:`CHECK_MODULE` runs, each
+    with its path in the package."""
     digest = hashlib.sha256()
     for path in module_sources(CHECK_MODULE, package_dir):
         name = path.relative_to(Path(package_dir).resolve()).as_posix()
@@ -51,8 +46,7 @@ def check_code_digest(package_dir: str | os.PathLike = PACKAGE_DIR) -> str:
     return digest.hexdigest()
 
 
-#: Where the pipeline keeps the verdicts of the dataset check (by file content), one
-#: folder per version of the check's code.
+#: Where the pipeline keeps the dataset check's verdicts, a folder per version of its code.
 DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / f"dataset-check-{check_code_digest()[:16]}"
 
 #: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
@@ -78,7 +72,11 @@ class ExperimentPart:
 
 
 def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[ExperimentPart]:
-    """The chains of a config's experiment, reading measured datasets' metadata.
+    """The chains of a config's experiment: none with ``experiment.source: none``, one
+    per configured chain for the virtual experiment, one per measured dataset (read from
+    its metadata); ConfigError naming ``experiment.datasets[i]`` when a dataset's
+    metadata is missing or wrong, its name unusable in file names, or its name and N
+    those of another.
 
     Parameters
     ----------
@@ -86,14 +84,6 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
         A config that passed :func:`chain.pipeline.config.check.check_config`.
     root : path
         Folder that relative dataset paths start from (the working directory).
-
-    Returns
-    -------
-    list of ExperimentPart
-        Empty with ``experiment.source: none``; one per configured chain for the virtual
-        experiment; one per dataset for measured datasets. ConfigError naming
-        ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong, its
-        name unusable in file names, or its name and N those of another.
     """
     experiment = config.get("experiment", {})
     source = experiment.get("source", "none")
@@ -170,7 +160,8 @@ def check_experiment_datasets(
     root: str | os.PathLike = ".",
     cache_dir: str | os.PathLike | None = DEFAULT_CACHE,
 ) -> None:
-    """Check every measured dataset of a config's experiment; raise listing all problems.
+    """Check every measured dataset of a config's experiment; ConfigError listing all
+    problems.
 
     Parameters
     ----------

@@ -102,14 +102,9 @@ def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = Tru
 
 
 def headline_numbers(summary: dict) -> dict[str, float]:
-    """Flatten the headline numbers of a ``summary.json`` into {name: value}, names such
-    as ``C_us_N16/simulation/elastic/N=25/fit_full`` (a failing check reads on its own).
-
-    Parameters
-    ----------
-    summary : dict
-        The parsed summary.json of a run.
-    """
+    """Flatten the headline numbers of ``summary`` (a run's parsed summary.json) into
+    {name: value}, names such as ``C_us_N16/simulation/elastic/N=25/fit_full`` (a
+    failing check reads on its own)."""
     numbers = {
         "C_bal/paper_form": summary["constants"]["C_bal_paper_us_N16"],
         "C_bal/exact_contact_time": summary["constants"]["C_bal_exact_us_N16"],

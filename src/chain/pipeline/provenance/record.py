@@ -149,14 +149,9 @@ def compare_with_lock(
 
 
 def lock_warnings(provenance: Mapping | None) -> list[str]:
-    """What a check says about a run's recorded versions against the lock: a line naming
-    every package that differs, a line when nothing could be compared, or nothing.
-
-    Parameters
-    ----------
-    provenance : mapping or None
-        The ``provenance`` block of a run's summary.json (:func:`run_provenance`).
-    """
+    """What a check says about the versions recorded in ``provenance`` (a run's
+    summary.json block, :func:`run_provenance`, or None) against the lock: a line naming
+    every package that differs, a line when nothing could be compared, or nothing."""
     lock = (provenance or {}).get("lock")
     if not lock:
         return ["summary.json records no comparison with the lock (an older run?)"]
