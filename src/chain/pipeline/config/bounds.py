@@ -18,17 +18,10 @@ from chain.pipeline.config.bounds_run import check_run_bounds
 
 
 def variant_config(config: Mapping, overrides: Mapping) -> dict:
-    """The config an ablation variant runs: ``experiment.virtual`` with the variant's
-    overrides (``striker_radius_m`` into ``setup``, ``tolerance`` into ``experiment``),
-    the virtual experiment as the source, and no variants of its own.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in).
-    overrides : mapping
-        The variant's ``set``.
-    """
+    """The config an ablation variant runs: the schema-valid ``config`` with the
+    variant's ``overrides`` (its ``set``: ``striker_radius_m`` into ``setup``,
+    ``tolerance`` into ``experiment``, the rest into ``experiment.virtual``), the virtual
+    experiment as the source, and no variants of its own."""
     derived = copy.deepcopy(dict(config))
     experiment = derived["experiment"]
     experiment.update(source="virtual", datasets=[])

@@ -86,10 +86,10 @@ def check_multiple(path, interval: float, step: float, step_key: str) -> None:
         )
 
 
-def check_passing(config: Mapping, path, duration: float, v0: float, what, sensors=None):
+def check_passing(config: Mapping, path, duration: float, v0: float, what: str) -> None:
     """``duration`` (s) >= DURATION_MARGIN x the passing time of the slowest pulse, that
-    of bead 1 launched at ``v0`` (m/s), on every chain (``sensors``: entry -> beads)."""
-    worst = slowest_passing(config, v0, sensors)
+    of bead 1 launched at ``v0`` (m/s), on every chain; ``what`` names the launch."""
+    worst = slowest_passing(config, v0)
     needed = DURATION_MARGIN * worst["time_s"]
     if duration < needed:
         fail(

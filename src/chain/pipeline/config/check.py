@@ -32,15 +32,13 @@ from chain.pipeline.config.virtual import virtual_experiment
 DURATION_MARGIN = 1.2
 
 
-def slowest_passing(config: Mapping, v0: float, sensors=None) -> dict:
-    """:func:`chain.physics.theory.pulse_passing_time` and ``N`` of the chain whose far
-    sensor the wave of bead 1 launched at ``v0`` (m/s) passes last (``sensors``: chain
-    entry -> its sensor beads; default the entry's ``sensors``)."""
+def slowest_passing(config: Mapping, v0: float) -> dict:
+    """:func:`chain.physics.theory.pulse_passing_time` and ``N`` of the chain of
+    ``config`` whose far sensor the wave of bead 1 launched at ``v0`` (m/s) passes last."""
 
     def passing(entry: Mapping) -> dict:
-        beads = sensors(entry) if sensors else entry["sensors"]
-        found = pulse_passing_time(config["material"], config["radius_m"], entry["N"], beads, v0)
-        return found | {"N": entry["N"]}
+        args = config["material"], config["radius_m"], entry["N"], entry["sensors"], v0
+        return pulse_passing_time(*args) | {"N": entry["N"]}
 
     return max(map(passing, config["chains"]), key=lambda found: found["time_s"])
 
@@ -66,18 +64,10 @@ def _check_step(path, step, interval: float, interval_key: str) -> None:
 
 
 def launch_ratios(config: Mapping, virtual: Mapping) -> tuple[float, float]:
-    """(least, most) V_m / V0 of the virtual experiment's launch: a striker of mass m_s
-    stops or bounces back elastically, handing the chain between m_s V0 and
-    2 m_s m / (m_s + m) V0; a launched bead (``launch: bead``) gives V_m =
-    LAUNCH_VELOCITY_RATIO x V0.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (its radius and striker radius, m).
-    virtual : mapping
-        Its ``experiment.virtual``.
-    """
+    """(least, most) V_m / V0 of the launch of ``virtual`` (``experiment.virtual`` of the
+    schema-valid ``config``): a striker of mass m_s stops or bounces back elastically,
+    handing the chain between m_s V0 and 2 m_s m / (m_s + m) V0; a launched bead
+    (``launch: bead``) gives V_m = LAUNCH_VELOCITY_RATIO x V0."""
     if virtual.get("launch", "striker") == "bead":
         return LAUNCH_VELOCITY_RATIO, LAUNCH_VELOCITY_RATIO
     mass_ratio = (config["setup"]["striker_radius_m"] / config["radius_m"]) ** 3

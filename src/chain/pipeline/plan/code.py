@@ -145,7 +145,8 @@ def _targets(root: Path, module: str, names: list[str]) -> list[Path]:
 
 def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) -> list[str]:
     """Source files a workflow script runs, besides itself: its local helpers and the
-    package files it imports, transitively.
+    package files it imports, transitively; sorted, relative to the current directory
+    (a moved or copied checkout names the same inputs).
 
     Parameters
     ----------
@@ -153,12 +154,6 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
         The script (``workflow/scripts/fig4_delay_vs_force.py``).
     package_dir : path
         The ``chain`` package folder the jobs import (``src/chain``).
-
-    Returns
-    -------
-    list of str
-        Sorted paths relative to the current directory (so that a moved or copied
-        checkout names the same inputs).
     """
     script, root = Path(script).resolve(), Path(package_dir).resolve()
     files = {f for m, _ in _imported_names(script) if (f := script.parent / f"{m}.py").is_file()}
@@ -170,16 +165,8 @@ def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) ->
 
 
 def module_sources(module: str, package_dir: str | os.PathLike) -> list[Path]:
-    """The package files that importing a module of the package runs (absolute, sorted):
-    its own file, the ``__init__`` files of the packages it is in, and what they import,
-    transitively.
-
-    Parameters
-    ----------
-    module : str
-        Dotted name (``chain.apparatus.dataset_check``).
-    package_dir : path
-        The ``chain`` package folder (``src/chain``).
-    """
+    """The files of the package folder ``package_dir`` (``src/chain``) that importing
+    ``module`` (``chain.apparatus.dataset_check``) runs, absolute and sorted: its own, the
+    ``__init__`` files of the packages it is in, and what they import, transitively."""
     root = Path(package_dir).resolve()
     return sorted(set().union(*(_package_closure(root, f) for f in _targets(root, module, []))))

@@ -197,16 +197,9 @@ def check_experiment_datasets(
 
 
 def skipped_shot_rows(check: DatasetCheck, name: str) -> pd.DataFrame:
-    """Selection rows (:data:`chain.analysis.selection.SELECTION_COLUMNS`) of the shots
-    of a dataset left out for a dead or saturated channel, the channel as the reason.
-
-    Parameters
-    ----------
-    check : DatasetCheck
-        :func:`chain.apparatus.dataset_check.check_dataset` of the dataset.
-    name : str
-        Series name of the dataset (the ``model`` column).
-    """
+    """Selection rows (:data:`chain.analysis.selection.SELECTION_COLUMNS`) of the shots a
+    dataset's ``check`` (:func:`~chain.apparatus.dataset_check.check_dataset`) left out for
+    a dead or saturated channel, the channel as the reason; ``name``: its series."""
     rows = [
         {
             "source": "experiment",

@@ -79,12 +79,7 @@ def simulation_threads(
     5.2 ms: 4): one per :data:`SECONDS_PER_THREAD` of estimated integration, at least 1,
     at most the 2 ``n_launches`` launches (collision and reference shots share one
     thread pool) and :data:`MAX_THREADS`. Each launch runs on one thread: the results
-    do not depend on the count.
-
-    Parameters
-    ----------
-    model, n_launches, max_launch_speed, duration, dt
-        As in :func:`simulation_needs` (m/s, s).
+    do not depend on the count. Parameters as :func:`simulation_needs` (m/s, s).
     """
     n_launches = require_int("n_launches", n_launches, 1)
     duration = require_positive("duration", duration)
@@ -101,7 +96,8 @@ def simulation_needs(
     dt: float | None = None,
     threads: int = 1,
 ) -> JobNeeds:
-    """Memory and run time to ask for a simulate job (collision and reference batches).
+    """Memory (``mem_mb``, MB, a multiple of 100) and run time (``runtime``, minutes) to
+    ask for a simulate job (collision and reference batches).
 
     Parameters
     ----------
@@ -119,11 +115,6 @@ def simulation_needs(
         RK4 step, s; default :func:`chain.physics.time_step.default_time_step`.
     threads : int
         Cores the job gets (launches run in parallel threads).
-
-    Returns
-    -------
-    JobNeeds
-        ``mem_mb`` in MB (multiple of 100), ``runtime`` in minutes.
     """
     n_launches = require_int("n_launches", n_launches, 1)
     threads = require_int("threads", threads, 1)

@@ -18,14 +18,10 @@ from chain.analysis.ssw_fits import SSW_FIT_COLUMNS
 from chain.analysis.ssw_speed import SPEED_COLUMNS
 from chain.analysis.ssw_track import TRACK_COLUMNS
 
-#: Files of the results contract (design.md) in results/<run_name>/: the figures (Fig. 2
-#: with an experiment), and the contract columns of each table (more follow them).
-CONTRACT_FIGURES = (
-    "fig1_setup",
-    "fig3_simulation_traces",
-    "fig4_delay_vs_force",
-    "fig5_ssw_vs_force",
-    "ssw_spacetime",
+#: The results contract (design.md) in results/<run_name>/: the figures (Fig. 2 with an
+#: experiment), the contract columns of each table (more follow them), summary.json's keys.
+CONTRACT_FIGURES = tuple(
+    "fig1_setup fig3_simulation_traces fig4_delay_vs_force fig5_ssw_vs_force ssw_spacetime".split()
 )
 EXPERIMENT_FIGURES = ("fig2_experiment_traces",)
 CONTRACT_TABLES = {
@@ -37,17 +33,9 @@ CONTRACT_TABLES = {
     "ssw_track.csv": TRACK_COLUMNS[: TRACK_COLUMNS.index("separated") + 1],
     "ssw_speed.csv": SPEED_COLUMNS[: SPEED_COLUMNS.index("first_separated_contact") + 1],
 }
-SUMMARY_KEYS = (
-    "run_name",
-    "constants",
-    "paper",
-    "max_energy_drift",
-    "delay_fits",
-    "ssw_fits",
-    "ssw_resolved",
-    "ssw_separation",
-    "ssw_parity_ratio",
-    "ssw_far_field",
+SUMMARY_KEYS = tuple(
+    "run_name constants paper max_energy_drift delay_fits ssw_fits ssw_resolved "
+    "ssw_separation ssw_parity_ratio ssw_far_field".split()
 )
 
 #: Default tolerances, by kind of number and source. Simulations are deterministic
@@ -66,15 +54,8 @@ DEFAULT_TOLERANCES = {
 
 
 def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = True) -> list[str]:
-    """Contract files absent from ``run_folder``, empty, or lacking their columns / keys.
-
-    Parameters
-    ----------
-    run_folder : path
-        ``results/<run_name>``.
-    experiment : bool
-        Whether the run has an experiment side (then Fig. 2 is required too).
-    """
+    """Contract files absent from ``run_folder`` (``results/<run_name>``), empty, or
+    lacking their columns / keys; Fig. 2 too if the run has an ``experiment`` side."""
     import pandas as pd
 
     folder = Path(run_folder)
@@ -130,15 +111,9 @@ def tolerance_for(name: str, tolerances: dict) -> dict:
 
 
 def compare_with_reference(numbers: dict[str, float], reference: dict) -> list[str]:
-    """Headline numbers out of tolerance, missing or unexpected, one message each.
-
-    Parameters
-    ----------
-    numbers : dict
-        From :func:`headline_numbers`.
-    reference : dict
-        Parsed reference file: ``{"tolerances": {...}, "values": {name: value}}``.
-    """
+    """Headline ``numbers`` (:func:`headline_numbers`) out of tolerance, missing or
+    unexpected against ``reference`` (the parsed reference file: ``{"tolerances": {...},
+    "values": {name: value}}``), one message each."""
     tolerances = reference.get("tolerances", DEFAULT_TOLERANCES)
     expected = reference["values"]
     failures = []
@@ -174,15 +149,8 @@ def compare_with_reference(numbers: dict[str, float], reference: dict) -> list[s
 
 
 def reference_from_summary(summary: dict, note: str) -> dict:
-    """A reference file's content from a run's summary, with the default tolerances.
-
-    Parameters
-    ----------
-    summary : dict
-        Parsed summary.json.
-    note : str
-        Why the reference was (re)made; kept in the file.
-    """
+    """A reference file's content from a run's ``summary`` (parsed summary.json), with
+    the default tolerances and a ``note`` on why it was (re)made."""
     numbers = headline_numbers(summary)
     return {
         "about": (

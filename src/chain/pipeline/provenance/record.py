@@ -171,17 +171,10 @@ def lock_warnings(provenance: Mapping | None) -> list[str]:
 
 
 def run_provenance(config: Mapping, directory: str | os.PathLike) -> dict:
-    """The provenance of a run (summary.json; the article prints it): ``commit``, ``date``,
-    ``dirty``, ``config_hash``, ``versions`` (Python and the main packages), ``installed``
-    (every distribution) and ``lock`` (:func:`compare_with_lock`).
-
-    Parameters
-    ----------
-    config : mapping
-        The run's configuration as Snakemake holds it (after overlays).
-    directory : path
-        A directory of the workflow's checkout (the Snakefile's).
-    """
+    """The provenance of a run of ``config`` (as Snakemake holds it, after overlays) from
+    the checkout holding ``directory``, for summary.json and the article: ``commit``,
+    ``date``, ``dirty``, ``config_hash``, ``versions`` (Python and the main packages),
+    ``installed`` (every distribution) and ``lock`` (:func:`compare_with_lock`)."""
     installed = installed_distributions()
     return {
         **git_state(directory),
