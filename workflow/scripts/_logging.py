@@ -32,7 +32,11 @@ def start(snakemake) -> logging.Logger:
     # fontTools reports every font it subsets for a PDF at INFO (a hundred lines of glyph
     # lists per figure): not about the run, and formatting them costs time.
     logging.getLogger("fontTools").setLevel(logging.WARNING)
-    _use_job_threads(getattr(snakemake, "threads", None))
+    # numba's parallel loops on the job's threads, not on every core of the node (numba's
+    # default); scripts that use no numba do not import it here. Results do not depend on it.
+    numba, threads = sys.modules.get("numba"), getattr(snakemake, "threads", None)
+    if numba is not None and threads:
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     logger = logging.getLogger(f"rule {snakemake.rule}")
     logger.info("inputs: %s", list(snakemake.input))
     logger.info("outputs: %s", list(snakemake.output))
@@ -48,12 +52,3 @@ def stop_once(signum: int, frame) -> None:
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise SystemExit(SIGNAL_BASE + signum)
-
-
-def _use_job_threads(threads: int | None) -> None:
-    """Run numba's parallel loops on the job's ``threads`` only, not on every core of the
-    node (numba's default); scripts that use no numba do not import it here. Results do
-    not depend on the count."""
-    numba = sys.modules.get("numba")
-    if numba is not None and threads:
-        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))

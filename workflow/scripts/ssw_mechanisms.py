@@ -1,7 +1,6 @@
-"""tables/ssw_mechanisms.csv: SSW/F_m at S2 and C per mechanism and setting: the LAMMPS
-friction/rotation sweep and the virtual experiment's candidates
-(chain.studies.mechanism_table). The study's jobs fit every estimator; the run's main
-one is taken here (params estimator)."""
+"""tables/ssw_mechanisms.csv: SSW/F_m at S2 and C of the run's main estimator (params
+estimator) per mechanism and setting: the LAMMPS friction/rotation sweep and the virtual
+experiment's candidates (chain.studies.mechanism_table)."""
 
 import pandas as pd
 from _logging import start

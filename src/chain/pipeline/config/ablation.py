@@ -2,9 +2,7 @@
 and acceptance tolerance per chain, and their checks.
 
 Each variant overrides keys of ``experiment.virtual`` (and ``setup.striker_radius_m``,
-``experiment.tolerance``; ``tolerance: null`` keeps every shot). The study that runs them
-is :mod:`chain.studies.ablation`; this module maps config keys, for the config checks
-and the plan alike. It reads schema-valid configs and knows no Snakemake.
+``experiment.tolerance``; null keeps every shot); :mod:`chain.studies.ablation` runs them.
 """
 
 from __future__ import annotations
@@ -43,21 +41,9 @@ def ablation_variants(config: Mapping) -> list[dict]:
 def variant_settings(
     config: Mapping, variant: Mapping, n_beads: int, sensors: Sequence[int], replicate: int = 0
 ) -> dict:
-    """VirtualExperiment fields of one chain of one variant (plain values).
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config.
-    variant : mapping
-        An entry of :func:`ablation_variants`.
-    n_beads : int
-        N.
-    sensors : sequence of int
-        Sensor beads [S1, S2].
-    replicate : int
-        Replicate number k >= 0; the seed is the run's (seed + N) + 1000 k.
-    """
+    """VirtualExperiment fields (plain values) of ``variant`` (:func:`ablation_variants`)
+    on the chain of ``n_beads`` beads and ``sensors`` [S1, S2] of the schema-valid
+    ``config``, replicate number ``replicate`` k >= 0 (the seed: seed + N + 1000 k)."""
     settings = virtual_experiment_settings(config, n_beads, sensors)
     for key, value in variant["set"].items():
         if key in VIRTUAL_KEYS:

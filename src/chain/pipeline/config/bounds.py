@@ -37,19 +37,10 @@ def variant_config(config: Mapping, overrides: Mapping) -> dict:
 
 
 def check_bounds(config: Mapping, check: Callable[[Mapping], None] | None = None) -> None:
-    """Check the bounds of a schema-valid config that depend on other keys;
-    :class:`ConfigError` naming the first offending key.
-
-    Parameters
-    ----------
-    config : mapping
-        The config after schema validation (defaults filled in) and the checks of
-        :func:`chain.pipeline.config.check.check_config` up to the ablation.
-    check : callable, optional
-        The whole config check, run again on each ablation variant's config
-        (:func:`variant_config`), whatever the source (`snakemake ablation` runs them
-        all); None skips the variants.
-    """
+    """Check the bounds that depend on other keys of ``config`` (schema-valid, checked up
+    to the ablation), then run ``check`` (the whole config check; None: not) on each
+    ablation variant's config (:func:`variant_config`), whatever the source: `snakemake
+    ablation` runs them all. :class:`ConfigError` naming the first offending key."""
     check_run_bounds(config)
     if config["experiment"]["source"] == "virtual":
         check_experiment_bounds(config)

@@ -2,10 +2,9 @@
 narrowest and the smallest pulse, the sensor spring against a given time step, the launch
 delay against the sensors, the selection tolerance against the shots' speed mismatch.
 
-Pulses are estimated as in :mod:`chain.pipeline.config.bounds_run`, from the launch's
-V_m / V0 (:func:`chain.pipeline.config.check.launch_ratios`). Each check takes the
-estimate that refuses only what cannot work: the widest possible pulse for a sampling
-bound, the largest possible for a detection bound. Reads no file, knows no Snakemake.
+Pulses are estimated as in :mod:`.bounds_run`, from the launch's V_m / V0
+(:func:`chain.pipeline.config.launch_ratios`), each check taking the estimate that refuses only what
+cannot work: the widest possible pulse for a sampling bound, the largest for detection.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ from chain.analysis.pulses import DEFAULT_MIN_SNR
 from chain.physics.materials import get_material, sphere_mass
 from chain.physics.theory import LAUNCH_VELOCITY_RATIO
 from chain.physics.time_step import STEPS_PER_SPRING_PERIOD
-from chain.pipeline.config import fail
+from chain.pipeline.config import fail, launch_ratios, slowest_passing
 from chain.pipeline.config.bounds_run import (
     MIN_SENSOR_DISTANCE,
     check_passing,
@@ -28,7 +27,6 @@ from chain.pipeline.config.bounds_run import (
     pulse_speed,
     sensor_room,
 )
-from chain.pipeline.config.check import launch_ratios, slowest_passing
 from chain.pipeline.config.virtual import virtual_experiment
 
 #: Standard deviations of the random launch jitter a delay bound covers (99.7 % of shots).

@@ -2,9 +2,8 @@
 collision point, record intervals against time steps and the narrowest pulse,
 durations against the slowest wave, LAMMPS file names.
 
-Also the pulse estimates :mod:`chain.pipeline.config.bounds_experiment` shares: a pulse of
-incident amplitude F_m = F(V_m) (Eq. 5) has the half width tau = R sqrt(10) / v (Eq. 4).
-Reads no file, knows no Snakemake.
+Also the pulse estimates :mod:`.bounds_experiment` shares: a pulse of incident amplitude
+F_m = F(V_m) (Eq. 5) has the half width tau = R sqrt(10) / v (Eq. 4).
 """
 
 from __future__ import annotations
@@ -20,8 +19,7 @@ from chain.physics.theory import (
     nesterenko_speed_from_force,
     pulse_half_width,
 )
-from chain.pipeline.config import fail
-from chain.pipeline.config.check import check_samples, slowest_passing
+from chain.pipeline.config import check_samples, fail, slowest_passing
 from chain.studies.mechanism_settings import setting_name, sweep_settings, viscous_name
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
@@ -114,11 +112,9 @@ def _check_sensors(config: Mapping) -> None:
         middle = collision_point(entry["N"])
         for j, room in enumerate(sensor_room(entry)):
             if room < MIN_SENSOR_DISTANCE:
-                side, allowed = (
-                    ("left", f"S1 <= {middle - MIN_SENSOR_DISTANCE:g}")
-                    if j == 0
-                    else ("right", f"S2 >= {middle + MIN_SENSOR_DISTANCE:g}")
-                )
+                side = ("left", "right")[j]
+                limit = middle - MIN_SENSOR_DISTANCE if j == 0 else middle + MIN_SENSOR_DISTANCE
+                allowed = f"S1 <= {limit:g}" if j == 0 else f"S2 >= {limit:g}"
                 fail(
                     ["chains", i, "sensors", j],
                     f"bead {entry['sensors'][j]} is {room:g} beads {side} of the collision "

@@ -1,12 +1,9 @@
 """The table docs/config_bounds.md: every key of the config schema, its unit, smallest
 and largest usable value, and what else bounds it and why.
 
-The schema's own bounds (``minimum``, ``maxLength``, ``enum``...) fill the value
-columns; :data:`RULES` adds, per key, the bounds that need other keys
-(:mod:`chain.pipeline.config.check` and :mod:`chain.pipeline.config.bounds`), or says why a
-key has no upper bound. ``python -m chain.pipeline.config.bounds_table SCHEMA`` prints
-the table; a test checks that the committed one is that output, and that every key has
-a largest value or a rule.
+The schema's own bounds fill the value columns; :data:`RULES` adds the bounds that need
+other keys, or why a key has no upper bound. ``python -m chain.pipeline.config.bounds_table
+SCHEMA`` prints the table; a test keeps the committed one equal to it.
 """
 
 from __future__ import annotations
@@ -164,18 +161,10 @@ RULES = {
     ),
 }
 
-_LOWER = {
-    "minimum": ">= {}",
-    "exclusiveMinimum": "> {}",
-    "minItems": "{} items",
-    "minLength": "{} characters",
-}
-_UPPER = {
-    "maximum": "<= {}",
-    "exclusiveMaximum": "< {}",
-    "maxItems": "{} items",
-    "maxLength": "{} characters",
-}
+#: Schema keywords of a key's smallest and largest value, as the table writes them.
+_LOWER = {"minimum": ">= {}", "exclusiveMinimum": "> {}", "minItems": "{} items"}
+_UPPER = {"maximum": "<= {}", "exclusiveMaximum": "< {}", "maxItems": "{} items"}
+_LOWER["minLength"] = _UPPER["maxLength"] = "{} characters"
 
 #: Written in the "largest" column of a choice (an enum or a boolean).
 CHOICE = "(a choice)"

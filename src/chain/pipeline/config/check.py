@@ -1,19 +1,15 @@
 """Checks on a pipeline configuration that a JSON schema cannot express.
 
-After the schema (``workflow/schemas/config.schema.yaml``: types, ranges, defaults),
-:func:`check_config` checks that every number is finite (the schema's minimum/maximum let
-NaN through), then the relations between keys, then the bounds that need a second key
+After the schema (types, ranges, defaults), :func:`check_config` checks that every number
+is finite, the relations between keys, then the bounds that need a second key
 (:mod:`chain.pipeline.config.bounds`). Every message starts with the dotted key (``config
 key 'chains[1].sensors': ...``) and says what is allowed, so that a bad config stops before
-any job runs and says where. It takes a plain dict, reads no file, knows no Snakemake;
-what a checked config means for the run is :class:`chain.pipeline.plan.run_plan.RunPlan`.
+any job runs and says where. A plain dict in; no file read, no Snakemake.
 
 Duration: a record must last :data:`DURATION_MARGIN` times the time the slowest wave
 (bead 1 launched at ``launch.v0_min_m_s``) needs to pass the sensor farthest from its
-launching end (:func:`chain.physics.theory.pulse_passing_time`, with V_m =
-LAUNCH_VELOCITY_RATIO x V0: the same for every material and radius by the scaling
-symmetry of the Hertz chain). The paper run passes with 2.6 ms against 1.9 ms. The SSW
-search after the crossed pulse is cut at the end of a shorter record: not an error.
+launching end (:func:`chain.physics.theory.pulse_passing_time`). The paper run passes with
+2.6 ms against 1.9 ms; the SSW search is cut at the end of a shorter record.
 """
 
 from __future__ import annotations
@@ -22,35 +18,13 @@ from collections.abc import Mapping
 
 from chain.errors import ConfigError, ParameterError, key_label, nonfinite_paths
 from chain.physics.materials import MATERIALS, get_material
-from chain.physics.theory import LAUNCH_VELOCITY_RATIO, force_from_bead_velocity, pulse_passing_time
-from chain.pipeline.config import fail
+from chain.physics.theory import force_from_bead_velocity
+from chain.pipeline.config import check_samples, fail, launch_ratios, slowest_passing
 from chain.pipeline.config.ablation import check_ablation
 from chain.pipeline.config.virtual import virtual_experiment
 
-#: The duration must be this many times the time the slowest pulse needs to pass the
-#: far sensor (see the module docstring).
+#: The duration over the time the slowest pulse needs to pass the far sensor, at least.
 DURATION_MARGIN = 1.2
-
-
-def slowest_passing(config: Mapping, v0: float) -> dict:
-    """:func:`chain.physics.theory.pulse_passing_time` and ``N`` of the chain of
-    ``config`` whose far sensor the wave of bead 1 launched at ``v0`` (m/s) passes last."""
-
-    def passing(entry: Mapping) -> dict:
-        args = config["material"], config["radius_m"], entry["N"], entry["sensors"], v0
-        return pulse_passing_time(*args) | {"N": entry["N"]}
-
-    return max(map(passing, config["chains"]), key=lambda found: found["time_s"])
-
-
-def check_samples(path, duration: float, interval: float, interval_key: str) -> None:
-    """``duration`` (s) holds at least 10 samples of ``interval`` (s), the key named."""
-    if duration < 10 * interval:
-        fail(
-            path,
-            f"{duration:g} s holds fewer than 10 samples of {interval_key} = {interval:g} s; "
-            f"allowed: >= {10 * interval:g} s",
-        )
 
 
 def _check_step(path, step, interval: float, interval_key: str) -> None:
@@ -61,18 +35,6 @@ def _check_step(path, step, interval: float, interval_key: str) -> None:
             f"{step:g} s is longer than {interval_key} = {interval:g} s; allowed: <= the {what}, "
             "or null",
         )
-
-
-def launch_ratios(config: Mapping, virtual: Mapping) -> tuple[float, float]:
-    """(least, most) V_m / V0 of the launch of ``virtual`` (``experiment.virtual`` of the
-    schema-valid ``config``): a striker of mass m_s stops or bounces back elastically,
-    handing the chain between m_s V0 and 2 m_s m / (m_s + m) V0; a launched bead
-    (``launch: bead``) gives V_m = LAUNCH_VELOCITY_RATIO x V0."""
-    if virtual.get("launch", "striker") == "bead":
-        return LAUNCH_VELOCITY_RATIO, LAUNCH_VELOCITY_RATIO
-    mass_ratio = (config["setup"]["striker_radius_m"] / config["radius_m"]) ** 3
-    most = LAUNCH_VELOCITY_RATIO * 2.0 * mass_ratio / (1.0 + mass_ratio)
-    return LAUNCH_VELOCITY_RATIO * mass_ratio, most
 
 
 def _check_sources(experiment: Mapping) -> None:
@@ -92,7 +54,9 @@ def _check_sources(experiment: Mapping) -> None:
         )
 
 
-def _check_virtual_keys(virtual: Mapping, base: list) -> None:
+def _check_virtual(config: Mapping) -> None:
+    virtual = config.get("experiment", {}).get("virtual", {})
+    base = ["experiment", "virtual"]
     if virtual.get("impact_speeds_m_s") is not None and virtual.get("drop_heights_m") is not None:
         fail(
             [*base, "drop_heights_m"],
@@ -102,12 +66,6 @@ def _check_virtual_keys(virtual: Mapping, base: list) -> None:
     key = "sampling_interval_s"
     check_samples([*base, "duration_s"], virtual.get("duration_s", 0.0), sampling, key)
     _check_step([*base, "time_step_s"], virtual.get("time_step_s"), sampling, key)
-
-
-def _check_virtual(config: Mapping) -> None:
-    virtual = config.get("experiment", {}).get("virtual", {})
-    base = ["experiment", "virtual"]
-    _check_virtual_keys(virtual, base)
     for entry in config["chains"]:
         try:
             settings = virtual_experiment(config, entry["N"], entry["sensors"])
@@ -272,6 +230,6 @@ def check_config(config: Mapping) -> None:
     _check_analysis_and_figures(config, names, seen_n)
     _check_experiment(config)
     check_ablation(config)
-    from chain.pipeline.config.bounds import check_bounds  # imports this module
+    from chain.pipeline.config.bounds import check_bounds  # imports pandas: only here
 
     check_bounds(config, check_config)

@@ -1,11 +1,9 @@
 """The pipeline's config files as text: YAML mistakes named by file and line.
 
-Snakemake reports a config file it cannot parse as "Config file is not valid JSON or
-YAML", without file or line, and a key given twice silently keeps the last value.
-:func:`check_config_files` reads the files before Snakemake does (``config.yaml``) or
-again after it (the ``--configfile`` overlays) and names both. An overlay that is not
-YAML at all stops Snakemake before the Snakefile runs, with Snakemake's own message;
-``python -m chain.pipeline.config.files whatif/x.yaml`` names file and line.
+Snakemake reports a config file it cannot parse without file or line, and a key given
+twice silently keeps the last value. An overlay that is not YAML at all stops Snakemake
+before the Snakefile runs; ``python -m chain.pipeline.config.files whatif/x.yaml`` names
+file and line.
 """
 
 from __future__ import annotations
@@ -29,13 +27,11 @@ class _StrictLoader(yaml.SafeLoader):
             key = self.construct_object(key_node, deep=True)
             line = key_node.start_mark.line + 1
             if key in seen:
-                raise yaml.constructor.ConstructorError(
-                    None,
-                    None,
+                problem = (
                     f"key {key!r} is given twice (lines {seen[key]} and {line}); YAML would "
-                    "keep only the last",
-                    key_node.start_mark,
+                    "keep only the last"
                 )
+                raise yaml.constructor.ConstructorError(None, None, problem, key_node.start_mark)
             seen[key] = line
         return super().construct_mapping(node, deep=deep)
 

@@ -16,19 +16,10 @@ VIRTUAL_KEYS = tuple(f.name for f in fields(VirtualExperiment) if f.name not in 
 
 
 def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence[int]) -> dict:
-    """The VirtualExperiment fields of one chain of a config, as plain values: the run's
-    material and radius (m), ``setup.striker_radius_m``, the seed + N (the chains' shots
-    differ), and ``experiment.virtual`` under its own names.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in).
-    n_beads : int
-        N.
-    sensors : sequence of int
-        Sensor beads [S1, S2].
-    """
+    """The VirtualExperiment fields, as plain values, of the chain of ``n_beads`` beads
+    and ``sensors`` [S1, S2] of the schema-valid ``config``: its material and radius (m),
+    ``setup.striker_radius_m``, the seed + N (the chains' shots differ), and
+    ``experiment.virtual`` under its own names."""
     return {
         **config["experiment"]["virtual"],
         "n_beads": int(n_beads),

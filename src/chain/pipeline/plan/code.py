@@ -1,10 +1,8 @@
 """Which source files a workflow script runs: the rule inputs that follow the code.
 
 A rule must rerun when the code its script runs changes, and only then. The files are
-read off the import statements (``ast``, nothing is imported): the script's local
-helpers (``_logging.py`` beside it), and every module of the ``chain`` package it
-imports, transitively, with the ``__init__`` files on the way; a new import in the
-library needs no edit in the rules.
+read off the import statements (``ast``; nothing is imported), transitively, so that a
+new import in the library needs no edit in the rules.
 """
 
 from __future__ import annotations
@@ -28,13 +26,10 @@ _UNSAVED: set[str] = set()
 
 
 def remember_imports(store: str | os.PathLike) -> None:
-    """Keep the import statements read between processes, in the JSON file ``store``:
-    call once before the rules ask for their code, and :func:`save_imports` after.
-
-    Every Snakemake command (and cluster job) parses the workflow, and parsing the
-    package for its imports took ~0.3 s of it; a file is read again only when its
-    modification time (ns) or size changed. A missing or unreadable store is empty.
-    """
+    """Keep the import statements read between processes (parsing them took ~0.3 s of
+    every Snakemake command) in the JSON file ``store``: call once before the rules ask
+    for their code, and :func:`save_imports` after. A file is read again only when its
+    modification time or size changed; a missing or unreadable store is an empty one."""
     try:
         known = json.loads(Path(store).read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -144,17 +139,10 @@ def _targets(root: Path, module: str, names: list[str]) -> list[Path]:
 
 
 def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) -> list[str]:
-    """Source files a workflow script runs, besides itself: its local helpers and the
-    package files it imports, transitively; sorted, relative to the current directory
-    (a moved or copied checkout names the same inputs).
-
-    Parameters
-    ----------
-    script : path
-        The script (``workflow/scripts/fig4_delay_vs_force.py``).
-    package_dir : path
-        The ``chain`` package folder the jobs import (``src/chain``).
-    """
+    """Source files ``script`` (``workflow/scripts/fig4_delay_vs_force.py``) runs besides
+    itself: its local helpers and the files it imports of ``package_dir`` (``src/chain``),
+    transitively; sorted, relative to the current directory (a moved or copied checkout
+    names the same inputs)."""
     script, root = Path(script).resolve(), Path(package_dir).resolve()
     files = {f for m, _ in _imported_names(script) if (f := script.parent / f"{m}.py").is_file()}
     for module, names in _imported_names(script):

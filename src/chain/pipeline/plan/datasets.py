@@ -1,13 +1,10 @@
 """The experiment's parts (chains and their datasets) and labels, and the measured
 datasets a config uses, checked before any job runs.
 
-:func:`check_experiment_datasets` checks every shot file of ``experiment.datasets`` as
-the pipeline builds its DAG and stops with one :class:`~chain.errors.ConfigError` listing
-every problem (file, line, column, what was expected). With ``experiment.bad_channels:
-skip``, shots with a dead or saturated channel are left out instead, and listed as
-rejected in ``experiment/selection.csv`` (:func:`skipped_shot_rows`). The check's
-verdicts are cached in a folder named by a digest of its code (:data:`DEFAULT_CACHE`):
-an edit of that code starts an empty one.
+Every problem of every shot file is listed at once (file, line, column, what was
+expected). With ``experiment.bad_channels: skip``, shots with a dead or saturated channel
+are left out, and listed as rejected (:func:`skipped_shot_rows`). The verdicts are cached
+in a folder named by a digest of the check's code (:data:`DEFAULT_CACHE`).
 """
 
 from __future__ import annotations
@@ -25,9 +22,8 @@ import pandas as pd
 from chain.analysis.selection import SELECTION_COLUMNS
 from chain.apparatus.dataset_check import DatasetCheck, check_dataset
 from chain.apparatus.measured import MeasuredDataError, read_metadata, usable_shots
-from chain.errors import ConfigError
+from chain.errors import ConfigError, key_label
 from chain.labels import SKIPPED_REASON, VIRTUAL_LABEL, VIRTUAL_SERIES
-from chain.pipeline.config import fail
 from chain.pipeline.plan.code import module_sources
 
 #: The module whose verdicts are cached, and the package it is in.
@@ -53,6 +49,10 @@ DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / f"dataset-check-{check_code_
 SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
 
+def _fail(path, message: str):
+    raise ConfigError(f"config key {key_label(path)!r}: {message}")
+
+
 @dataclass(frozen=True)
 class ExperimentPart:
     """One chain of the experiment: where its traces come from."""
@@ -72,19 +72,11 @@ class ExperimentPart:
 
 
 def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[ExperimentPart]:
-    """The chains of a config's experiment: none with ``experiment.source: none``, one
-    per configured chain for the virtual experiment, one per measured dataset (read from
-    its metadata); ConfigError naming ``experiment.datasets[i]`` when a dataset's
-    metadata is missing or wrong, its name unusable in file names, or its name and N
-    those of another.
-
-    Parameters
-    ----------
-    config : mapping
-        A config that passed :func:`chain.pipeline.config.check.check_config`.
-    root : path
-        Folder that relative dataset paths start from (the working directory).
-    """
+    """The chains of the experiment of ``config`` (checked): none with ``experiment.source:
+    none``, one per configured chain for the virtual experiment, one per measured dataset
+    (read from its metadata; relative folders start from ``root``); ConfigError naming
+    ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong, its name
+    unusable in file names, or its name and N those of another."""
     experiment = config.get("experiment", {})
     source = experiment.get("source", "none")
     name = experiment.get("name")
@@ -99,14 +91,14 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
     seen: dict[tuple[str, int], int] = {}
     for i, folder in enumerate(experiment.get("datasets", [])):
         path = ["experiment", "datasets", i]
-        where = Path(folder) if Path(folder).is_absolute() else Path(root) / folder
+        where = Path(root) / folder  # an absolute folder as it is
         try:
             meta = read_metadata(where)
         except MeasuredDataError as error:
-            fail(path, f"{error}")
+            _fail(path, f"{error}")
         series = name or meta.name or where.resolve().name
         if not SERIES_NAME.match(series):
-            fail(
+            _fail(
                 path,
                 f"dataset name {series!r} (metadata name, else folder name) is not usable "
                 "in file names; allowed: letters, digits, '_', '-', starting with a "
@@ -114,23 +106,17 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
             )
         key = (series, meta.n_beads)
         if key in seen:
-            fail(
+            _fail(
                 path,
                 f"gives the series {series!r} with N = {meta.n_beads} again (as "
                 f"experiment.datasets[{seen[key]}]); allowed: one dataset per name and N",
             )
         seen[key] = i
-        files = ("metadata.yaml", *(shot.file for shot in meta.shots))
-        parts.append(
-            ExperimentPart(
-                series,
-                meta.n_beads,
-                tuple(meta.sensor_beads),
-                str(folder),
-                tuple(str(Path(folder) / file) for file in files),
-                VIRTUAL_LABEL in (meta.description or ""),
-            )
-        )
+        listed = ("metadata.yaml", *(shot.file for shot in meta.shots))
+        files = tuple(str(Path(folder) / file) for file in listed)
+        virtual = VIRTUAL_LABEL in (meta.description or "")
+        beads = tuple(meta.sensor_beads)
+        parts.append(ExperimentPart(series, meta.n_beads, beads, str(folder), files, virtual))
     return parts
 
 
@@ -160,22 +146,10 @@ def check_experiment_datasets(
     root: str | os.PathLike = ".",
     cache_dir: str | os.PathLike | None = DEFAULT_CACHE,
 ) -> None:
-    """Check every measured dataset of a config's experiment; ConfigError listing all
-    problems.
-
-    Parameters
-    ----------
-    config : mapping
-        A config that passed :func:`chain.pipeline.config.check.check_config`.
-    parts : sequence of ExperimentPart
-        :func:`experiment_parts` of it (virtual parts, pipeline outputs, are skipped).
-    root : path
-        Folder that relative dataset paths start from.
-    cache_dir : path or None
-        Verdict cache (relative paths start from ``root``), made private (0700); the
-        folders beside it named ``dataset-check*`` (other versions of the check's code)
-        are removed. None checks every file.
-    """
+    """Check every measured dataset of ``parts`` (:func:`experiment_parts` of the checked
+    ``config``; relative folders start from ``root``); ConfigError listing all problems.
+    ``cache_dir`` keeps the verdicts (relative to ``root``; private, 0700; the folders of
+    other versions of the check's code beside it are removed); None checks every file."""
     policy = bad_channel_policy(config)
     cache = None if cache_dir is None else Path(root) / cache_dir
     for old in [] if cache is None else cache.parent.glob("dataset-check*"):

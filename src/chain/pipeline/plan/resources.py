@@ -1,21 +1,15 @@
 """What a simulation job asks a batch scheduler for: memory (MB) and run time (minutes).
 
-A SLURM job is killed when it passes its memory or time request, and waits longer in the
-queue the more it asks, so the simulate rule asks for what its chain needs.
+A SLURM job is killed when it passes its request, and waits longer the more it asks.
 
 Memory: the integrator keeps every recorded sample of every particle of a batch of B
-launches, (B, S, P) arrays with S = duration / record_interval samples. The simulate
-script's peak resident memory, measured (``resource.getrusage``) for N = 16..100 beads,
-4..24 launch speeds and 1.5..5.2 ms, is 200 MB + (48 N + 80) bytes x B x S within 10 MB
-(48 bytes: six float64 per particle and sample). The first job with an empty numba
-cache compiles the kernels, peaking at ~590 MB before any trace: the base of the
-request. The request is :data:`SAFETY` times that plus the Snakemake process.
+launches. The simulate script's peak, measured for N = 16..100, 4..24 launch speeds and
+1.5..5.2 ms, is 200 MB + (48 N + 80) bytes x B x S (S samples) within 10 MB; with an
+empty numba cache, compiling the kernels peaks at ~590 MB first: the request's base.
 
 Run time: RK4 costs at most :data:`SECONDS_PER_PARTICLE_STEP` per particle and step on
-one core of the (shared, loaded) test machine; a job runs 2 B launches of duration / dt
-steps, dt :func:`chain.physics.time_step.default_time_step` at the fastest launch unless
-the config sets it. Every paper job asks for :data:`MIN_RUNTIME_MIN`; the estimate
-matters for long sweeps (N = 100, 5 ms, 24 speeds: ~40 s of work).
+one core; a job runs 2 B launches of duration / dt steps. Every paper job asks for
+:data:`MIN_RUNTIME_MIN`; the estimate matters for long sweeps (N = 100, 5 ms, 24 speeds).
 """
 
 from __future__ import annotations

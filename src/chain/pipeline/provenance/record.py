@@ -1,11 +1,9 @@
 """Which run produced an article: commit, commit date, config hash and package versions,
 and whether those versions are the lock's.
 
-A function of the inputs, never of the clock, so that the same checkout and config give
-the same article bytes: the date is the commit's (UTC). Outside a git checkout the
-commit says so; uncommitted changes are named. A run records every installed version
-and which of them differ from its Python's lock (``requirements/py3XX.lock``), so that a
-number that moved can be traced to the release that moved it.
+Never the clock: the same checkout and config give the same article bytes (the date is
+the commit's). Every installed version is recorded, and which differ from the Python's
+lock (``requirements/py3XX.lock``): a number that moved can be traced to its release.
 """
 
 from __future__ import annotations
@@ -41,15 +39,10 @@ def config_hash(config: Mapping) -> str:
 
 def _git(directory: str | os.PathLike, *args: str) -> str | None:
     """Output of ``git -C directory args``, or None where git or the checkout is absent."""
+    command = ["git", "-C", os.fspath(directory), *args]
+    env = {**os.environ, "LC_ALL": "C", "TZ": "UTC"}
     try:
-        done = subprocess.run(
-            ["git", "-C", os.fspath(directory), *args],
-            capture_output=True,
-            text=True,
-            timeout=20,
-            check=False,
-            env={**os.environ, "LC_ALL": "C", "TZ": "UTC"},
-        )
+        done = subprocess.run(command, capture_output=True, text=True, timeout=20, env=env)
     except (OSError, subprocess.SubprocessError):
         return None
     return done.stdout.strip() if done.returncode == 0 else None
@@ -115,29 +108,21 @@ def read_lock(path: str | os.PathLike) -> dict[str, str]:
 def compare_with_lock(
     directory: str | os.PathLike, installed: Mapping[str, str] | None = None
 ) -> dict:
-    """How the installed packages compare with the running Python's lock:
-    ``{"file", "matches", "differ", "note"}``: the lock (relative to the checkout),
-    whether every locked package is installed at its locked version, and ``{name:
-    {"locked", "installed"}}`` for each one that is not. Without a lock for this Python
-    in the checkout, ``file`` and ``matches`` are None and ``note`` says so.
-
-    Parameters
-    ----------
-    directory : path
-        Top folder of the checkout (the Snakefile's).
-    installed : mapping, optional
-        ``{normalized name: version}``; default :func:`installed_distributions`.
+    """How the ``installed`` packages (``{normalized name: version}``; default
+    :func:`installed_distributions`) compare with the running Python's lock in the
+    checkout whose top folder is ``directory``: ``{"file", "matches", "differ", "note"}``,
+    the lock (relative to the checkout), whether every locked package is installed at its
+    locked version, and ``{name: {"locked", "installed"}}`` for each one that is not.
+    Without a lock for this Python, ``file`` and ``matches`` are None and ``note`` says so.
     """
     path = lock_path(directory)
     relative = f"{LOCK_FOLDER}/{path.name}"
     if not path.is_file():
-        return {
-            "file": None,
-            "matches": None,
-            "differ": {},
-            "note": f"no {relative} for Python {platform.python_version()} in this copy "
-            "of the workflow (not a checkout, or an unlocked Python): versions not compared",
-        }
+        note = (
+            f"no {relative} for Python {platform.python_version()} in this copy of the "
+            "workflow (not a checkout, or an unlocked Python): versions not compared"
+        )
+        return {"file": None, "matches": None, "differ": {}, "note": note}
     installed = installed_distributions() if installed is None else installed
     differ = {
         name: {"locked": locked, "installed": installed.get(name, NOT_INSTALLED)}
