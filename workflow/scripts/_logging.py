@@ -11,13 +11,10 @@ SIGNAL_BASE = 128
 
 
 def start(snakemake) -> logging.Logger:
-    """Redirect stderr and the root logger to ``snakemake.log[0]``; return a logger.
-
-    Also turn SIGTERM into ``SystemExit``, so that a job stopped mid-write (by a batch
-    system, a container, ``kill -TERM``) leaves no temporary file: the atomic writers
-    delete theirs on the way out; and skip the garbage collections of the job's exit
-    (0.25-0.5 s: chain.pipeline.run.run_end).
-    """
+    """Redirect stderr and the root logger to ``snakemake.log[0]``; return a logger. Also
+    turn SIGTERM into ``SystemExit`` (a job stopped mid-write leaves no temporary file: the
+    atomic writers delete theirs on the way out), and skip the garbage collections of the
+    job's exit (0.25-0.5 s: chain.pipeline.run.run_end)."""
     signal.signal(signal.SIGTERM, stop_once)
     freeze_at_exit()
     stream = open(snakemake.log[0], "w", buffering=1)  # lives as long as the job

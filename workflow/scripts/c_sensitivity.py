@@ -15,12 +15,9 @@ p = snakemake.params
 # every pair recorded: eta (s) -> N -> trace table.
 traces = {}
 for job in p.jobs:
+    args = chain_of(job), job["speeds_m_s"], job["sensors"]
     traces.setdefault(job["eta_s"], {})[job["N"]], _ = simulate_shots(
-        chain_of(job),
-        job["speeds_m_s"],
-        job["sensors"],
-        model_name=job["model"],
-        **simulation_kwargs(job),
+        *args, model_name=job["model"], **simulation_kwargs(job)
     )
     log.info("eta = %g s, N = %d, beads %s simulated", job["eta_s"], job["N"], job["sensors"])
 table = c_sensitivity_every_estimator(traces, p.plan)

@@ -25,13 +25,9 @@ def variant_config(config: Mapping, overrides: Mapping) -> dict:
     derived = copy.deepcopy(dict(config))
     experiment = derived["experiment"]
     experiment.update(source="virtual", datasets=[])
+    homes = {"striker_radius_m": derived["setup"], "tolerance": experiment}
     for key, value in overrides.items():
-        if key == "striker_radius_m":
-            derived["setup"]["striker_radius_m"] = value
-        elif key == "tolerance":
-            experiment["tolerance"] = value
-        else:
-            experiment["virtual"][key] = value
+        homes.get(key, experiment["virtual"])[key] = value
     derived["ablation"] = {"variants": []}
     return derived
 

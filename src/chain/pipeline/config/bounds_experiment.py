@@ -169,24 +169,15 @@ def check_experiment_bounds(config: Mapping) -> None:
     for entry in config["chains"]:
         settings = virtual_experiment(config, entry["N"], entry["sensors"])
         _check_tolerance(config, settings)
-    speeds = settings.nominal_speeds
-    fastest = float(max(speeds))
-    check_resolution(
-        config,
-        ["experiment", "virtual", "sampling_interval_s"],
-        virtual["sampling_interval_s"],
-        ratios[0] * fastest,
-        f"{virtual['launch']} at {fastest:g} m/s",
-    )
+    speeds, base = settings.nominal_speeds, ["experiment", "virtual"]
+    fastest, slowest = float(max(speeds)), float(min(speeds))
+    sampling, duration = virtual["sampling_interval_s"], virtual["duration_s"]
+    what = f"{virtual['launch']} at {fastest:g} m/s"
+    check_resolution(config, [*base, "sampling_interval_s"], sampling, ratios[0] * fastest, what)
     # Duration: the slowest launch's wave at the most it can be passes the far sensors.
-    slowest = float(min(speeds))
-    check_passing(
-        config,
-        ["experiment", "virtual", "duration_s"],
-        virtual["duration_s"],
-        ratios[1] * slowest / LAUNCH_VELOCITY_RATIO,
-        f"{virtual['launch']} at {slowest:g} m/s, as bead 1 launched",
-    )
+    v0 = ratios[1] * slowest / LAUNCH_VELOCITY_RATIO
+    what = f"{virtual['launch']} at {slowest:g} m/s, as bead 1 launched"
+    check_passing(config, [*base, "duration_s"], duration, v0, what)
     _check_detection(config, virtual, speeds, ratios)
     _check_sensor_spring(config, virtual)
     _check_delay(config, virtual, speeds, ratios)

@@ -145,15 +145,11 @@ def _check_long_chains(config: Mapping) -> None:
     duration = config.get("long_chains", {}).get("duration_s")
     if duration is None:
         return
+    v0, what = config["launch"]["v0_min_m_s"], "bead 1 launched, to the middle bead"
     for n in config["long_chains"].get("N", []):
         middle = (n + 1) // 2
-        check_passing(
-            {**config, "chains": [{"N": n, "sensors": [middle, middle]}]},
-            ["long_chains", "duration_s"],
-            duration,
-            config["launch"]["v0_min_m_s"],
-            "bead 1 launched, to the middle bead",
-        )
+        long_chain = {**config, "chains": [{"N": n, "sensors": [middle, middle]}]}
+        check_passing(long_chain, ["long_chains", "duration_s"], duration, v0, what)
 
 
 def _check_lammps(config: Mapping) -> None:

@@ -8,7 +8,10 @@ SCHEMA`` prints the table; a test keeps the committed one equal to it.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Mapping
+
+import yaml
 
 from chain.analysis.pulses import DEFAULT_MIN_SNR, MIN_FIT_SAMPLES
 from chain.pipeline.config.bounds_experiment import JITTER_SIGMAS, MIN_KEPT_SHOTS
@@ -250,10 +253,6 @@ def bounds_table(schema: Mapping) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m chain.pipeline.config.bounds_table SCHEMA``: print :func:`bounds_table`."""
-    import sys
-
-    import yaml
-
     path = (sys.argv[1:] if argv is None else argv)[0]
     with open(path, encoding="utf-8") as handle:
         sys.stdout.write(bounds_table(yaml.safe_load(handle)))

@@ -85,13 +85,6 @@ def _check_virtual(config: Mapping) -> None:
         )
 
 
-def _check_experiment(config: Mapping) -> None:
-    experiment = config.get("experiment", {})
-    _check_sources(experiment)
-    if experiment.get("source", "none") == "virtual":
-        _check_virtual(config)
-
-
 def check_finite(config: Mapping) -> None:
     """Every number of ``config`` (a mapping, validated or not) is finite, else
     :class:`ConfigError` naming each key: the schema's minimum/maximum let NaN through,
@@ -228,7 +221,10 @@ def check_config(config: Mapping) -> None:
     names = _check_models_and_launch(config)
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
-    _check_experiment(config)
+    experiment = config.get("experiment", {})
+    _check_sources(experiment)
+    if experiment.get("source", "none") == "virtual":
+        _check_virtual(config)
     check_ablation(config)
     from chain.pipeline.config.bounds import check_bounds  # imports pandas: only here
 

@@ -121,10 +121,9 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
 
 
 def experiment_label(parts: Sequence[ExperimentPart]) -> str:
-    """How figures and the summary name the experiment series of ``parts``
-    (:func:`experiment_parts`): ``"virtual experiment (model)"``, ``"measured
-    (<names>)"``, or ``"virtual experiment (model): <names>"`` for a measured-format
-    dataset that the virtual experiment wrote (still not data)."""
+    """How figures and the summary name the series of ``parts`` (:func:`experiment_parts`):
+    ``"virtual experiment (model)"``, ``"measured (<names>)"``, or ``"virtual experiment
+    (model): <names>"`` for a dataset the virtual experiment wrote (still not data)."""
     if not parts:
         return "experiment"
     if all(part.folder is None for part in parts):

@@ -1,9 +1,8 @@
 """Headline numbers of a run, compared with a committed reference (what CI checks).
 
-From a run's ``summary.json``: the ballistic constants C_bal, C of Delta = C F_m^(-1/6)
-and the free exponent per source, model, N and estimator, the SSW slopes, and the
-largest energy drift of the conservative runs. The reference file holds them with each
-kind's tolerance; it changes only in a reviewed commit that says why.
+From a run's ``summary.json``: C_bal, C and the free exponent per source, model, N and
+estimator, the SSW slopes, the largest energy drift of the conservative runs. The
+reference holds them with tolerances; it changes only in a reviewed commit saying why.
 """
 
 from __future__ import annotations
@@ -38,9 +37,8 @@ SUMMARY_KEYS = tuple(
     "ssw_separation ssw_parity_ratio ssw_far_field".split()
 )
 
-#: Default tolerances, by kind of number and source. Simulations are deterministic
-#: but may differ in the last bits between CPUs (FMA, libm); the virtual experiment
-#: adds seeded noise on top, so its numbers are allowed more.
+#: Default tolerances, by kind of number and source: simulations may differ in the last
+#: bits between CPUs (FMA, libm); the virtual experiment adds seeded noise on top.
 DEFAULT_TOLERANCES = {
     "C_bal": {"relative": 1e-6},
     "C_us_N16/simulation": {"relative": 0.005},
