@@ -17,9 +17,9 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import update_config, validate
 
 from chain.analysis.pulses import ESTIMATORS
-from chain.errors import ConfigError
+from chain.errors import ConfigError, key_label
 from chain.physics.materials import MATERIALS
-from chain.pipeline.config.check import check_config, key_name
+from chain.pipeline.config.check import check_config
 from chain.pipeline.plan.datasets import experiment_parts
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -540,9 +540,9 @@ def test_bad_config_is_stopped_naming_the_key(paper, change, where, message):
     assert message in error, error
 
 
-def test_key_name():
-    assert key_name(["chains", 0, "sensors", 1]) == "chains[0].sensors[1]"
-    assert key_name([]) == "<top level>"
+def test_key_label():
+    assert key_label(["chains", 0, "sensors", 1]) == "chains[0].sensors[1]"
+    assert key_label([]) == "<top level>"
 
 
 @pytest.mark.parametrize(

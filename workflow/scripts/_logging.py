@@ -11,14 +11,10 @@ SIGNAL_BASE = 128
 
 
 def start(snakemake) -> logging.Logger:
-    """Redirect stderr and the root logger to ``snakemake.log[0]``; return a logger.
-
-    Also turn SIGTERM into ``SystemExit``, so that a job terminated mid-write (a batch
-    system's or a container's stop, ``kill -TERM`` of the process group) leaves no
-    temporary file: the atomic writers delete theirs on the way out. SIGINT already
-    arrives as ``KeyboardInterrupt``. And skip the garbage collections of the job's exit
-    (0.25-0.5 s for pandas, numba, matplotlib: chain.pipeline.run.run_end).
-    """
+    """Redirect stderr and the root logger to ``snakemake.log[0]``; return a logger. Also
+    turn SIGTERM into ``SystemExit`` (a job stopped mid-write leaves no temporary file: the
+    atomic writers delete theirs on the way out), and skip the garbage collections of the
+    job's exit (0.25-0.5 s: chain.pipeline.run.run_end)."""
     signal.signal(signal.SIGTERM, stop_once)
     freeze_at_exit()
     stream = open(snakemake.log[0], "w", buffering=1)  # lives as long as the job
@@ -33,7 +29,11 @@ def start(snakemake) -> logging.Logger:
     # fontTools reports every font it subsets for a PDF at INFO (a hundred lines of glyph
     # lists per figure): not about the run, and formatting them costs time.
     logging.getLogger("fontTools").setLevel(logging.WARNING)
-    _use_job_threads(getattr(snakemake, "threads", None))
+    # numba's parallel loops on the job's threads, not on every core of the node (numba's
+    # default); scripts that use no numba do not import it here. Results do not depend on it.
+    numba, threads = sys.modules.get("numba"), getattr(snakemake, "threads", None)
+    if numba is not None and threads:
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     logger = logging.getLogger(f"rule {snakemake.rule}")
     logger.info("inputs: %s", list(snakemake.input))
     logger.info("outputs: %s", list(snakemake.output))
@@ -42,23 +42,10 @@ def start(snakemake) -> logging.Logger:
 
 def stop_once(signum: int, frame) -> None:
     """Signal handler: end the job as SIGINT (KeyboardInterrupt) or SIGTERM (SystemExit
-    with status 128 + signal) do, once; later SIGINT and SIGTERM are ignored, so that a
-    signal that arrives twice (sent to a process group, and passed on by a parent)
-    cannot cut the atomic writers' clean-up short."""
+    with status 128 + signal) do, once, then ignore both: a signal that arrives twice (to
+    a process group, and passed on by a parent) cannot cut the writers' clean-up short."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise SystemExit(SIGNAL_BASE + signum)
-
-
-def _use_job_threads(threads: int | None) -> None:
-    """Run numba's parallel loops (the integrator's launches) on the job's cores only.
-
-    numba starts one thread per core of the machine, which on a cluster node is far
-    more than the job's allocation (the rule's ``threads:``, sbatch --cpus-per-task).
-    Scripts that use no numba do not import it here. Results do not depend on the count.
-    """
-    numba = sys.modules.get("numba")
-    if numba is not None and threads:
-        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))

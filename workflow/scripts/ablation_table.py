@@ -1,6 +1,5 @@
-"""tables/ablation_exponent.csv from the fits of every ablation variant
-(chain.studies.ablation_table.ablation_table): the rows of the run's main estimator
-(params estimator; each variant's job fits every estimator)."""
+"""tables/ablation_exponent.csv from every ablation variant's fits of the run's main
+estimator (params estimator) (chain.studies.ablation_table.ablation_table)."""
 
 import pandas as pd
 from _logging import start
@@ -10,10 +9,9 @@ from chain.atomic import write_csv_atomic
 from chain.studies.ablation_table import ablation_table
 
 log = start(snakemake)
-p = snakemake.params
+p, i = snakemake.params, snakemake.input
 fits = {
-    name: of_estimator(pd.read_csv(path), p.estimator)
-    for name, path in zip(p.variants, snakemake.input.fits)
+    name: of_estimator(pd.read_csv(path), p.estimator) for name, path in zip(p.variants, i.fits)
 }
 table = ablation_table(fits, p.overrides)
 log.info("%d rows", len(table))

@@ -26,14 +26,8 @@ for replicate, (chains, reads_run) in enumerate(zip(p.settings, p.reads_run, str
     pooled = first[first["N"].astype(str) == "pooled"].iloc[0]
     log.info(
         "%s replicate %d (seeds %s), %s: C = %.2f +- %.2f us N^1/6, exponent %.4f +- %.4f",
-        snakemake.wildcards.variant,
-        replicate,
-        seeds,
-        p.estimators[0],
-        pooled["C_us_N16"],
-        pooled["C_stderr_us_N16"],
-        pooled["exponent"],
-        pooled["exponent_stderr"],
+        *(snakemake.wildcards.variant, replicate, seeds, p.estimators[0]),
+        *pooled[["C_us_N16", "C_stderr_us_N16", "exponent", "exponent_stderr"]],
     )
     tables.append(fits.assign(replicate=replicate, seeds=" ".join(map(str, seeds))))
     ssw_tables.append(ssw_fits.assign(replicate=replicate))

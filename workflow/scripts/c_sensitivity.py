@@ -15,23 +15,13 @@ p = snakemake.params
 # every pair recorded: eta (s) -> N -> trace table.
 traces = {}
 for job in p.jobs:
+    args = chain_of(job), job["speeds_m_s"], job["sensors"]
     traces.setdefault(job["eta_s"], {})[job["N"]], _ = simulate_shots(
-        chain_of(job),
-        job["speeds_m_s"],
-        job["sensors"],
-        model_name=job["model"],
-        **simulation_kwargs(job),
+        *args, model_name=job["model"], **simulation_kwargs(job)
     )
     log.info("eta = %g s, N = %d, beads %s simulated", job["eta_s"], job["N"], job["sensors"])
 table = c_sensitivity_every_estimator(traces, p.plan)
-for row in table[table["N"].astype(str) == "pooled"].itertuples():
-    log.info(
-        "headline %s; %s = %s: C = %.2f +- %.2f, p = %.4f",
-        row.main_estimator,
-        row.choice,
-        row.value,
-        row.C,
-        row.C_stderr,
-        row.exponent,
-    )
+columns = ["main_estimator", "choice", "value", "C", "C_stderr", "exponent"]
+for row in table[table["N"].astype(str) == "pooled"][columns].itertuples(index=False):
+    log.info("headline %s; %s = %s: C = %.2f +- %.2f, p = %.4f", *row)
 write_csv_atomic(table, snakemake.output[0])

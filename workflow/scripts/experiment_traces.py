@@ -7,24 +7,18 @@ from chain.apparatus.measured import load_dataset
 from chain.traces import write_traces
 
 log = start(snakemake)
-datasets = snakemake.params.datasets
-for dataset, folder, traces in zip(datasets, dataset_folders(snakemake), snakemake.output):
+p = snakemake.params
+for dataset, folder, traces in zip(p.datasets, dataset_folders(snakemake), snakemake.output):
     table = load_dataset(
-        folder,
-        name=dataset["name"],
-        bad_channels=snakemake.params.bad_channels,
-        cache_dir=snakemake.params.cache,
+        folder, name=dataset["name"], bad_channels=p.bad_channels, cache_dir=p.cache
     )
     if set(table["N"]) != {dataset["N"]}:
         raise ValueError(f"{folder}: N = {sorted(set(table['N']))}, expected {dataset['N']}")
     shots = table.drop_duplicates("shot")
+    counts = [int((shots["kind"] == kind).sum()) for kind in ("collision", "reference")]
     log.info(
         "%s -> %s: %d collision and %d reference shots, %d amplitudes",
-        folder,
-        traces,
-        int((shots["kind"] == "collision").sum()),
-        int((shots["kind"] == "reference").sum()),
-        shots["amplitude"].nunique(),
+        *(folder, traces, *counts, shots["amplitude"].nunique()),
     )
     write_traces(table, traces)  # atomic: temporary file, then rename
 log.info("done")

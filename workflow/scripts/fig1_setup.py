@@ -1,7 +1,5 @@
 """Fig. 1, the setup, drawn from the configured chains (chain.report.figures.fig1_setup)."""
 
-from pathlib import Path
-
 from _logging import start
 
 from chain.report.figures.fig1_setup import fig1_setup
@@ -10,10 +8,7 @@ from chain.report.figures.style import save_figure
 log = start(snakemake)
 p = snakemake.params
 fig = fig1_setup(
-    p.chains,
-    bead_radius_m=p.radius_m,
-    striker_radius_m=p.striker_radius_m,
-    material=p.material,
+    p.chains, bead_radius_m=p.radius_m, striker_radius_m=p.striker_radius_m, material=p.material
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

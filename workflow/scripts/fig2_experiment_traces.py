@@ -1,8 +1,6 @@
 """Fig. 2: experiment forces at the sensor beads, a shot the acceptance protocol kept
 (chain.report.figures.fig2_experiment_traces)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _inputs import selection
 from _logging import start
@@ -23,5 +21,5 @@ fig = fig2_experiment_traces(
     label=p.label,
     selection=selection(snakemake),
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

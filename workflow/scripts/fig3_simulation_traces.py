@@ -1,7 +1,5 @@
 """Fig. 3: simulated forces at the sensor beads (chain.report.figures.fig3_simulation_traces)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -22,5 +20,5 @@ fig = fig3_simulation_traces(
     estimator=p.estimator,
     label=p.label,
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

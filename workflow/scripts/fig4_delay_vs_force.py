@@ -1,7 +1,5 @@
 """Fig. 4: |Delta| against F_m (chain.report.figures.fig4_delay_vs_force)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -11,12 +9,10 @@ from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 p = snakemake.params
+delays, fits = pd.read_csv(snakemake.input.delays), pd.read_csv(snakemake.input.fits)
+constants = ballistic_constants(p.material, p.radius_m)
 fig = fig4_delay_vs_force(
-    pd.read_csv(snakemake.input.delays),
-    pd.read_csv(snakemake.input.fits),
-    constants=ballistic_constants(p.material, p.radius_m),
-    estimator=p.estimator,
-    experiment_label=p.experiment_label,
+    delays, fits, constants=constants, estimator=p.estimator, experiment_label=p.experiment_label
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

@@ -1,7 +1,5 @@
 """Supplementary figure: C against our choices (chain.report.figures.fig_c_sensitivity)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -10,5 +8,5 @@ from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_c_sensitivity(pd.read_csv(snakemake.input.table))
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

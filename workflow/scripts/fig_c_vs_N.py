@@ -1,7 +1,5 @@
 """Sweep figure: C against N, odd and even (chain.report.figures.fig_c_vs_N.fig_c_vs_N)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -10,5 +8,5 @@ from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_c_vs_N(pd.read_csv(snakemake.input.sweep))
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

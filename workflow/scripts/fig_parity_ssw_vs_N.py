@@ -1,7 +1,5 @@
 """What-if figure: SSW slope against N, odd and even (chain.report.figures.fig_parity_ssw_vs_N)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -12,5 +10,5 @@ log = start(snakemake)
 fig = fig_parity_ssw_vs_N(
     pd.read_csv(snakemake.input.fits), experiment_label=snakemake.params.experiment_label
 )
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

@@ -1,8 +1,6 @@
 """The mechanism figure: SSW/F_m at S2 per mechanism and setting
 (chain.report.figures.fig_ssw_mechanisms)."""
 
-from pathlib import Path
-
 import pandas as pd
 from _logging import start
 
@@ -11,5 +9,5 @@ from chain.report.figures.style import save_figure
 
 log = start(snakemake)
 fig = fig_ssw_mechanisms(pd.read_csv(snakemake.input.table))
-save_figure(fig, Path(snakemake.output.pdf).with_suffix(""))
+save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
 log.info("done")

@@ -8,15 +8,7 @@ from chain.studies.lammps_check import run_lammps_check
 
 log = start(snakemake)
 table = run_lammps_check(snakemake.params.config, snakemake.params.estimators)
-for row in table.itertuples(index=False):
-    log.info(
-        "N = %d %s, %s: C kernel %.6f, LAMMPS %.6f (rel %.2g); traces within %.2g F_m",
-        row.N,
-        row.model,
-        row.estimator,
-        row.C_kernel,
-        row.C_lammps,
-        row.rel_diff_C,
-        row.max_trace_diff_over_Fm,
-    )
+columns = "N model estimator C_kernel C_lammps rel_diff_C max_trace_diff_over_Fm".split()
+for row in table[columns].itertuples(index=False):
+    log.info("N = %d %s, %s: C kernel %.6f, LAMMPS %.6f (rel %.2g); traces within %.2g F_m", *row)
 write_csv_atomic(table, snakemake.output[0])

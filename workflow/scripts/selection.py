@@ -28,15 +28,8 @@ if p.bad_channels == "skip":
     ]
     table = pd.concat([table, *skipped], ignore_index=True)
     table = table.sort_values(["source", "model", "N", "shot"], kind="stable")
-for (model, n, kind), group in table.groupby(["model", "N", "kind"]):
-    log.info(
-        "%s N = %s %s: %d kept, %d rejected",
-        model,
-        n,
-        kind,
-        group["kept"].sum(),
-        (~group["kept"]).sum(),
-    )
+for (model, n, kind), kept in table.groupby(["model", "N", "kind"])["kept"]:
+    log.info("%s N = %s %s: %d kept, %d rejected", model, n, kind, kept.sum(), (~kept).sum())
 for row in table[~table["kept"]].itertuples():
     log.info("rejected %s N = %s shot %s: %s", row.model, row.N, row.shot, row.reason)
 write_csv_atomic(table, snakemake.output[0])

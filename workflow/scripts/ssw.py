@@ -10,16 +10,11 @@ from chain.traces import read_traces
 
 log = start(snakemake)
 pulses = pd.read_csv(snakemake.input.pulses)
-shots = selection(snakemake)
+shots, estimator = selection(snakemake), snakemake.params.estimator
 tables = []
 # Trace files of this run: write_traces checked them in the job that wrote them.
 for path in snakemake.input.traces:
-    table = ssw_table(
-        read_traces(path, check=False),
-        pulses,
-        selection=shots,
-        estimator=snakemake.params.estimator,
-    )
+    table = ssw_table(read_traces(path, check=False), pulses, selection=shots, estimator=estimator)
     log.info("%s: %d SSW rows", path, len(table))
     tables.append(table)
 write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output[0])

@@ -1,9 +1,7 @@
 """Re-simulate the collision Fig. ssw_spacetime shows on each of its chains, every
-contact recorded, and write its field (chain.analysis.ssw_track.field_table).
-
-Only the shown shot is integrated again, at the time step of the whole batch of
-ssw_track, which makes it the same numbers bit for bit: a figure key (which collision
-is shown) recomputes milliseconds of integration, not the tracks."""
+contact recorded, and write its field (chain.analysis.ssw_track.field_table): that shot
+only, at the time step of ssw_track's whole batch (the same numbers bit for bit), so
+that a figure key recomputes milliseconds of integration, not the tracks."""
 
 import pandas as pd
 from _logging import start

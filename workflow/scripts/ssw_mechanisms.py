@@ -1,7 +1,6 @@
-"""tables/ssw_mechanisms.csv: SSW/F_m at S2 and C per mechanism and setting: the LAMMPS
-friction/rotation sweep and the virtual experiment's candidates
-(chain.studies.mechanism_table). The study's jobs fit every estimator; the run's main
-one is taken here (params estimator)."""
+"""tables/ssw_mechanisms.csv: SSW/F_m at S2 and C of the run's main estimator (params
+estimator) per mechanism and setting: the LAMMPS friction/rotation sweep and the virtual
+experiment's candidates (chain.studies.mechanism_table)."""
 
 import pandas as pd
 from _logging import start
@@ -16,42 +15,29 @@ from chain.studies.mechanism_table import (
 )
 
 log = start(snakemake)
-p = snakemake.params
-i = snakemake.input
+p, i = snakemake.params, snakemake.input
 
 
-def read(path):
-    return of_estimator(pd.read_csv(path), p.estimator)
+def read(paths):
+    return [of_estimator(pd.read_csv(path), p.estimator) for path in paths]
 
 
+# Delay fits and SSW fits of each LAMMPS setting; the viscous rows are read beside them.
+lammps = read(i.lammps_delay_fits), read(i.lammps_ssw_fits)
+viscous = read(i.viscous_delay_fits), read(i.viscous_ssw_fits)
 tables = []
-if i.lammps_delay_fits:
-    tables.append(
-        mechanism_rows(
-            FRICTION_MECHANISM,
-            p.labels,
-            [read(path) for path in i.lammps_delay_fits],
-            [read(path) for path in i.lammps_ssw_fits],
-            p.lammps_reference,
-        )
-    )
-if i.viscous_delay_fits:
-    tables.append(
-        mechanism_rows(
-            VISCOUS_MECHANISM,
-            p.viscous_labels,
-            [read(path) for path in [*i.lammps_delay_fits, *i.viscous_delay_fits]],
-            [read(path) for path in [*i.lammps_ssw_fits, *i.viscous_ssw_fits]],
-            p.lammps_reference,
-        )
-    )
+if lammps[0]:
+    tables.append(mechanism_rows(FRICTION_MECHANISM, p.labels, *lammps, p.lammps_reference))
+if viscous[0]:
+    both = [lammps[0] + viscous[0], lammps[1] + viscous[1]]
+    tables.append(mechanism_rows(VISCOUS_MECHANISM, p.viscous_labels, *both, p.lammps_reference))
 if p.candidates:
     names = list(p.candidates)
     tables.append(
         candidate_rows(
             {name: tuple(value) for name, value in p.candidates.items()},
-            dict(zip(names, map(read, i.candidate_fits))),
-            dict(zip(names, map(read, i.candidate_ssw_fits))),
+            dict(zip(names, read(i.candidate_fits))),
+            dict(zip(names, read(i.candidate_ssw_fits))),
             p.candidate_reference,
         )
     )

@@ -10,40 +10,35 @@ from chain.report.numbers.spread import ablation_summary, c_spread_summary
 from chain.report.numbers.summary import build_summary, write_summary_json
 
 log = start(snakemake)
-p = snakemake.params
+p, i = snakemake.params, snakemake.input
+delay_fits, delays, ssw = (pd.read_csv(path) for path in (i.delay_fits, i.delays, i.ssw))
 summary = build_summary(
     run_name=p.run_name,
     material=p.material,
     radius_m=p.radius_m,
-    delay_fits=pd.read_csv(snakemake.input.delay_fits),
-    ssw_fits=pd.read_csv(snakemake.input.ssw_fits),
-    runs=pd.concat([pd.read_csv(path) for path in snakemake.input.runs], ignore_index=True),
+    delay_fits=delay_fits,
+    ssw_fits=pd.read_csv(i.ssw_fits),
+    runs=pd.concat([pd.read_csv(path) for path in i.runs], ignore_index=True),
     conservative_models=p.conservative_models,
     main_estimator=p.estimator,
     experiment_label=p.experiment_label,
-    pulses=pd.read_csv(snakemake.input.pulses),
-    delays=pd.read_csv(snakemake.input.delays),
-    ssw=pd.read_csv(snakemake.input.ssw),
+    pulses=pd.read_csv(i.pulses),
+    delays=delays,
+    ssw=ssw,
     selection=selection(snakemake),
-    tolerance=p.tolerance if snakemake.input.get("selection") else None,
-    ssw_speed=pd.read_csv(snakemake.input.ssw_speed),
+    tolerance=p.tolerance if i.get("selection") else None,
+    ssw_speed=pd.read_csv(i.ssw_speed),
 )
-# The ablation verdict (with the virtual experiment) and the
-# spread of C over our choices.
-if snakemake.input.get("ablation"):
-    summary["ablation"] = ablation_summary(
-        pd.read_csv(snakemake.input.ablation[0]),
-        pd.read_csv(snakemake.input.delay_fits),
-        p.estimator,
-    )
-if snakemake.input.get("c_sensitivity"):
-    summary["c_spread"] = c_spread_summary(pd.read_csv(snakemake.input.c_sensitivity[0]))
+# The ablation verdict (with the virtual experiment) and the spread of C over our choices.
+if i.get("ablation"):
+    summary["ablation"] = ablation_summary(pd.read_csv(i.ablation[0]), delay_fits, p.estimator)
+if i.get("c_sensitivity"):
+    summary["c_spread"] = c_spread_summary(pd.read_csv(i.c_sensitivity[0]))
 # The mechanism study's verdict (LAMMPS rows only where LAMMPS is installed).
-if snakemake.input.get("mechanisms"):
-    check = snakemake.input.get("lammps_check")
+if i.get("mechanisms"):
     summary["ssw_mechanisms"] = mechanism_summary(
-        pd.read_csv(snakemake.input.mechanisms[0]),
-        pd.read_csv(check[0]) if check else None,
+        pd.read_csv(i.mechanisms[0]),
+        pd.read_csv(i.lammps_check[0]) if i.get("lammps_check") else None,
         friction=p.friction_mechanism,
         reference=p.reference_mechanism,
     )
@@ -51,9 +46,7 @@ if snakemake.input.get("mechanisms"):
 if p.studies_not_run:
     summary["studies_not_run"] = list(p.studies_not_run)
 # The claim table last: its "why not" quotes the studies above.
-summary = with_claims(
-    summary, pd.read_csv(snakemake.input.delays), pd.read_csv(snakemake.input.ssw)
-)
+summary = with_claims(summary, delays, ssw)
 summary["provenance"] = p.provenance  # versions, and the lock's
 write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])

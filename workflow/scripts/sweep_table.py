@@ -8,11 +8,7 @@ from chain.atomic import write_csv_atomic
 from chain.studies.sweep import sweep_table
 
 log = start(snakemake)
-table = sweep_table(
-    pd.read_csv(snakemake.input.delay_fits),
-    pd.read_csv(snakemake.input.ssw_fits),
-    snakemake.params.eta_s,
-    snakemake.params.estimator,
-)
+fits = pd.read_csv(snakemake.input.delay_fits), pd.read_csv(snakemake.input.ssw_fits)
+table = sweep_table(*fits, snakemake.params.eta_s, snakemake.params.estimator)
 log.info("%d rows (models x chains)", len(table))
 write_csv_atomic(table, snakemake.output[0])

@@ -12,14 +12,8 @@ speeds = settings.nominal_speeds
 log.info(
     "N = %d, sensors %s, %d amplitudes (%.3g..%.3g m/s), %d collision + %d reference shots "
     "each, seed %d",
-    settings.n_beads,
-    list(settings.sensor_beads),
-    len(speeds),
-    speeds.min(),
-    speeds.max(),
-    settings.collision_shots,
-    settings.reference_shots,
-    settings.seed,
+    *(settings.n_beads, list(settings.sensor_beads), len(speeds), speeds.min(), speeds.max()),
+    *(settings.collision_shots, settings.reference_shots, settings.seed),
 )
 # Written to a temporary folder that then replaces the output folder: all or nothing.
 run_virtual_experiment(settings, snakemake.output[0], snakemake.params.dataset)

@@ -1,12 +1,8 @@
 """The ``ablation`` section of a config: the variants, their virtual-experiment settings
 and acceptance tolerance per chain, and their checks.
 
-A config's ``ablation.variants`` lists named variants, each a set of overrides of
-``experiment.virtual`` keys (plus ``striker_radius_m`` of ``setup`` and ``tolerance`` of
-``experiment``; ``tolerance: null`` switches the acceptance protocol off). The study
-that runs them is :mod:`chain.studies.ablation`; this module only maps config keys, so
-that the config checks (:mod:`chain.pipeline.config.check`) and the rules share it. It reads
-schema-valid configs (defaults filled in) and knows no Snakemake.
+Each variant overrides keys of ``experiment.virtual`` (and ``setup.striker_radius_m``,
+``experiment.tolerance``; null keeps every shot); :mod:`chain.studies.ablation` runs them.
 """
 
 from __future__ import annotations
@@ -14,8 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from chain.apparatus.virtual_settings import VirtualExperiment, check_switches
-from chain.errors import ConfigError, ParameterError
-from chain.errors import key_label as key_name
+from chain.errors import ParameterError
+from chain.pipeline.config import fail
 from chain.pipeline.config.virtual import VIRTUAL_KEYS, virtual_experiment_settings
 
 #: Keys a variant may set besides those of ``experiment.virtual``.
@@ -45,21 +41,9 @@ def ablation_variants(config: Mapping) -> list[dict]:
 def variant_settings(
     config: Mapping, variant: Mapping, n_beads: int, sensors: Sequence[int], replicate: int = 0
 ) -> dict:
-    """VirtualExperiment fields of one chain of one variant (plain values).
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config.
-    variant : mapping
-        An entry of :func:`ablation_variants`.
-    n_beads : int
-        N.
-    sensors : sequence of int
-        Sensor beads [S1, S2].
-    replicate : int
-        Replicate number k >= 0; the seed is the run's (seed + N) + 1000 k.
-    """
+    """VirtualExperiment fields (plain values) of ``variant`` (:func:`ablation_variants`)
+    on the chain of ``n_beads`` beads and ``sensors`` [S1, S2] of the schema-valid
+    ``config``, replicate number ``replicate`` k >= 0 (the seed: seed + N + 1000 k)."""
     settings = virtual_experiment_settings(config, n_beads, sensors)
     for key, value in variant["set"].items():
         if key in VIRTUAL_KEYS:
@@ -73,44 +57,30 @@ def variant_settings(
 def variant_tolerance(config: Mapping, variant: Mapping) -> float | None:
     """Acceptance tolerance of a variant (relative amplitude mismatch); None: every
     collision shot is kept."""
-    overrides = variant["set"]
-    if "tolerance" in overrides:
-        return overrides["tolerance"]
-    return config["experiment"]["tolerance"]
+    return variant["set"].get("tolerance", config["experiment"]["tolerance"])
 
 
 def check_ablation(config: Mapping) -> None:
     """Check the ablation variants of a schema-valid config: unique names, known keys,
-    settings the virtual experiment accepts for every chain.
-
-    Raises
-    ------
-    ConfigError
-        Naming ``ablation.variants[i]`` and the key.
-    """
+    settings the virtual experiment accepts for every chain; else
+    :class:`~chain.errors.ConfigError` naming ``ablation.variants[i]`` and the key."""
     seen: dict[str, int] = {}
     for i, variant in enumerate(ablation_variants(config)):
         path = ["ablation", "variants", i]
         if variant["name"] in seen:
-            raise ConfigError(
-                f"config key {key_name([*path, 'name'])!r}: {variant['name']!r} is listed "
-                f"twice (also ablation.variants[{seen[variant['name']]}]); allowed: each "
-                "name once (file names)"
+            fail(
+                [*path, "name"],
+                f"{variant['name']!r} is listed twice (also ablation.variants"
+                f"[{seen[variant['name']]}]); allowed: each name once (file names)",
             )
         seen[variant["name"]] = i
         for key in variant["set"]:
             if key not in VIRTUAL_KEYS and key not in EXTRA_KEYS:
-                allowed = ", ".join([*VIRTUAL_KEYS, *EXTRA_KEYS])
-                raise ConfigError(
-                    f"config key {key_name([*path, 'set', key])!r}: unknown; allowed: {allowed}"
-                )
+                allowed = ", ".join(VIRTUAL_KEYS + EXTRA_KEYS)
+                fail([*path, "set", key], f"unknown; allowed: {allowed}")
         for entry in config["chains"]:
             try:
-                settings = VirtualExperiment.from_dict(
-                    variant_settings(config, variant, entry["N"], entry["sensors"])
-                )
-                check_switches(settings)
+                settings = variant_settings(config, variant, entry["N"], entry["sensors"])
+                check_switches(VirtualExperiment.from_dict(settings))
             except ParameterError as error:
-                raise ConfigError(
-                    f"config key {key_name([*path, 'set'])!r}: {error} (chain N = {entry['N']})"
-                ) from None
+                fail([*path, "set"], f"{error} (chain N = {entry['N']})")

@@ -1,16 +1,10 @@
-"""Bounds of the virtual experiment that depend on other keys: the
-digitiser against the narrowest and the smallest pulse, the sensor spring against a
-given time step, the launch delay against the sensors, the selection tolerance against
-the shots' speed mismatch.
+"""Bounds of the virtual experiment that depend on other keys: the digitiser against the
+narrowest and the smallest pulse, the sensor spring against a given time step, the launch
+delay against the sensors, the selection tolerance against the shots' speed mismatch.
 
-Pulse estimates as in :mod:`chain.pipeline.config.bounds_run`; a striker of mass m_s at
-V0 hands the chain a momentum between m_s V0 and 2 m_s V0 (it stops, or bounces back),
-so V_m = LAUNCH_VELOCITY_RATIO x (m_s / m) x V0 at the least and twice that at the
-most; a launched bead (``launch: bead``) gives V_m = LAUNCH_VELOCITY_RATIO x V0. Each
-check takes the estimate that refuses only what cannot work: the widest possible pulse
-for a sampling bound, the largest possible for a detection bound.
-
-This module reads no file and knows no Snakemake.
+Pulses are estimated as in :mod:`.bounds_run`, from the launch's V_m / V0
+(:func:`chain.pipeline.config.launch_ratios`), each check taking the estimate that refuses only what
+cannot work: the widest possible pulse for a sampling bound, the largest for detection.
 """
 
 from __future__ import annotations
@@ -22,16 +16,16 @@ import numpy as np
 
 from chain.analysis.pulses import DEFAULT_MIN_SNR
 from chain.physics.materials import get_material, sphere_mass
-from chain.physics.theory import LAUNCH_VELOCITY_RATIO, force_from_bead_velocity
+from chain.physics.theory import LAUNCH_VELOCITY_RATIO
 from chain.physics.time_step import STEPS_PER_SPRING_PERIOD
+from chain.pipeline.config import fail, launch_ratios, slowest_passing
 from chain.pipeline.config.bounds_run import (
     MIN_SENSOR_DISTANCE,
     check_passing,
     check_resolution,
-    fail,
+    pulse_force,
     pulse_speed,
     sensor_room,
-    slowest_passing,
 )
 from chain.pipeline.config.virtual import virtual_experiment
 
@@ -46,28 +40,12 @@ MIN_KEPT_SHOTS = 2
 FORCE_SPEED_EXPONENT = 1.2
 
 
-def launch_ratios(config: Mapping, virtual: Mapping) -> tuple[float, float]:
-    """(least, most) V_m / V0 of the virtual experiment's launch (module docstring)."""
-    if virtual.get("launch", "striker") == "bead":
-        return LAUNCH_VELOCITY_RATIO, LAUNCH_VELOCITY_RATIO
-    mass_ratio = (config["setup"]["striker_radius_m"] / config["radius_m"]) ** 3
-    # Elastic bounce: the bead gets 2 m_s / (m_s + m) V0 (the chain then takes more).
-    return LAUNCH_VELOCITY_RATIO * mass_ratio, LAUNCH_VELOCITY_RATIO * 2.0 * mass_ratio / (
-        1.0 + mass_ratio
-    )
-
-
-def _force(config: Mapping, bead_speed_m_s: float) -> float:
-    beads = get_material(config["material"])
-    return float(force_from_bead_velocity(bead_speed_m_s, beads, config["radius_m"]))
-
-
 def _check_detection(config: Mapping, virtual: Mapping, speeds, ratios) -> None:
     """The smallest pulse, damped by the track drag on its way to the far sensor, stands
     above the detection threshold: DEFAULT_MIN_SNR x the noise and x the ADC step."""
     base = ["experiment", "virtual"]
     slowest = float(min(speeds))
-    largest_of_smallest = _force(config, ratios[1] * slowest)
+    largest_of_smallest = pulse_force(config, ratios[1] * slowest)
     # Drag -m gamma v on every bead takes momentum as exp(-gamma t); F_m ~ V_m^(6/5).
     passing = slowest_passing(config, ratios[1] * slowest / LAUNCH_VELOCITY_RATIO)
     damping = math.exp(-FORCE_SPEED_EXPONENT * virtual["drag_rate_per_s"] * passing["time_s"])
@@ -162,8 +140,7 @@ def _check_delay(config: Mapping, virtual: Mapping, speeds, ratios) -> None:
 def _check_tolerance(config: Mapping, settings) -> None:
     """The selection keeps MIN_KEPT_SHOTS collision shots of a chain, judged by the
     planned speeds of the shots (seeded, so known before any job)."""
-    # The speeds alone, not the whole plan: every ablation variant is checked too, and
-    # building each plan (a DataFrame) took ~0.15 s of every command's parse.
+    # The speeds alone: building each variant's whole plan (a DataFrame) costs ~0.15 s.
     from chain.apparatus.virtual_plan import collision_speeds
 
     tolerance = config["experiment"].get("tolerance")
@@ -183,43 +160,24 @@ def _check_tolerance(config: Mapping, settings) -> None:
 
 
 def check_experiment_bounds(config: Mapping) -> None:
-    """The virtual experiment's bounds that need two keys (see the module docstring).
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config with ``experiment.source: virtual`` that passed the
-        checks of :func:`chain.pipeline.config.check.check_config` before the bounds.
-
-    Raises
-    ------
-    ConfigError
-        Naming the first offending key.
-    """
+    """The virtual experiment's bounds that need two keys (module docstring) in
+    ``config``, a schema-valid config with ``experiment.source: virtual`` that passed the
+    checks before the bounds; :class:`~chain.errors.ConfigError` naming the first
+    offending key."""
     virtual = config["experiment"]["virtual"]
     ratios = launch_ratios(config, virtual)
     for entry in config["chains"]:
         settings = virtual_experiment(config, entry["N"], entry["sensors"])
         _check_tolerance(config, settings)
-    speeds = settings.nominal_speeds
-    fastest = float(max(speeds))
-    check_resolution(
-        config,
-        ["experiment", "virtual", "sampling_interval_s"],
-        virtual["sampling_interval_s"],
-        ratios[0] * fastest,
-        f"{virtual['launch']} at {fastest:g} m/s",
-    )
-    # Duration: the slowest launch's wave at the most it can be (a bounced striker,
-    # V_m ratio 0.45 against 0.47 measured: slow already) passes the far sensors.
-    slowest = float(min(speeds))
-    check_passing(
-        config,
-        ["experiment", "virtual", "duration_s"],
-        virtual["duration_s"],
-        ratios[1] * slowest / LAUNCH_VELOCITY_RATIO,
-        f"{virtual['launch']} at {slowest:g} m/s, as bead 1 launched",
-    )
+    speeds, base = settings.nominal_speeds, ["experiment", "virtual"]
+    fastest, slowest = float(max(speeds)), float(min(speeds))
+    sampling, duration = virtual["sampling_interval_s"], virtual["duration_s"]
+    what = f"{virtual['launch']} at {fastest:g} m/s"
+    check_resolution(config, [*base, "sampling_interval_s"], sampling, ratios[0] * fastest, what)
+    # Duration: the slowest launch's wave at the most it can be passes the far sensors.
+    v0 = ratios[1] * slowest / LAUNCH_VELOCITY_RATIO
+    what = f"{virtual['launch']} at {slowest:g} m/s, as bead 1 launched"
+    check_passing(config, [*base, "duration_s"], duration, v0, what)
     _check_detection(config, virtual, speeds, ratios)
     _check_sensor_spring(config, virtual)
     _check_delay(config, virtual, speeds, ratios)

@@ -2,12 +2,8 @@
 collision point, record intervals against time steps and the narrowest pulse,
 durations against the slowest wave, LAMMPS file names.
 
-Also the pulse estimates the bounds of :mod:`chain.pipeline.config.bounds_experiment`
-share. A pulse of incident amplitude F_m has the half width tau = R sqrt(10) / v
-(Eq. 4, v of Eq. 5); F_m is estimated from the launch as in the duration check of
-:mod:`chain.pipeline.config.check`: V_m = LAUNCH_VELOCITY_RATIO x V0 for a launched bead.
-
-This module reads no file and knows no Snakemake.
+Also the pulse estimates :mod:`.bounds_experiment` shares: a pulse of incident amplitude
+F_m = F(V_m) (Eq. 5) has the half width tau = R sqrt(10) / v (Eq. 4).
 """
 
 from __future__ import annotations
@@ -16,59 +12,51 @@ from collections.abc import Mapping
 
 from chain.analysis.pulses import MIN_FIT_SAMPLES
 from chain.analysis.ssw_track import collision_point
-from chain.errors import ConfigError, key_label
 from chain.physics.materials import get_material
 from chain.physics.theory import (
     LAUNCH_VELOCITY_RATIO,
     force_from_bead_velocity,
     nesterenko_speed_from_force,
     pulse_half_width,
-    pulse_passing_time,
 )
-from chain.studies.mechanism_settings import (
-    setting_name,
-    sweep_settings,
-    viscous_name,
-)
+from chain.pipeline.config import check_samples, fail, slowest_passing
+from chain.studies.mechanism_settings import setting_name, sweep_settings, viscous_name
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
-#: the slowest pulse. 1, not chain.pipeline.config.check.DURATION_MARGIN (1.2, which also
-#: covers a striker's launch, estimated 12 % slow): a launched bead's estimate errs on
-#: the slow side already (ratio 0.45 against 0.47 measured), and whatif/brass.yaml's
-#: LAMMPS record (2.6 ms against 2.31 ms) passes its slowest wave.
+#: the slowest pulse: 1, not check.DURATION_MARGIN (1.2, which also covers a striker's
+#: launch): a launched bead's estimate errs on the slow side already (ratio 0.45 against
+#: 0.47 measured), and whatif/brass.yaml's LAMMPS record (2.6 ms against 2.31 ms) passes.
 DURATION_MARGIN = 1.0
 
-#: Smallest max_energy_drift with the default RK4 step: that step is chosen for a
-#: relative drift of about 1e-9 (measured 3.1e-10 at 1 m/s on the N = 26 chain).
+#: Smallest max_energy_drift with the default RK4 step, chosen for a relative drift of
+#: about 1e-9 (measured 3.1e-10 at 1 m/s on the N = 26 chain).
 DEFAULT_STEP_DRIFT = 1e-9
 
 #: Relative tolerance of "a whole number of time steps".
 MULTIPLE_TOLERANCE = 1e-9
 
-#: Least distance of a sensor bead from the collision point, beads. A sensor reads the
-#: incident pulse and then the crossed one, about 2 d / v later for a sensor d from the
-#: collision point, and chain.analysis.pulses.find_pulses must see two peaks. Measured
-#: (felt force, N = 16, 17, 25, 26, V0 = 0.1 and 1 m/s, eta 0.58 us): two pulses, both
-#: fitted, from d = 2 beads; one pulse at d = 1.5, 1, 0.5 and 0 (the waves merge there).
+#: Least distance of a sensor bead from the collision point, beads: the sensor must read
+#: the incident and the crossed pulse as two peaks (chain.analysis.pulses.find_pulses).
+#: Measured (N = 16..26, V0 = 0.1 and 1 m/s): two fitted pulses from 2 beads, one below.
 MIN_SENSOR_DISTANCE = 2.0
 
 
-def fail(path, message: str):
-    """Raise :class:`ConfigError` naming the key ``path`` (list of keys and indices)."""
-    raise ConfigError(f"config key {key_label(path)!r}: {message}")
+def pulse_force(config: Mapping, bead_speed_m_s: float) -> float:
+    """Incident amplitude F_m of the pulse a bead speed V_m (m/s) gives (Eq. 5), N."""
+    beads = get_material(config["material"])
+    return float(force_from_bead_velocity(bead_speed_m_s, beads, config["radius_m"]))
 
 
 def pulse_tau(config: Mapping, bead_speed_m_s: float) -> float:
     """Half width tau of the pulse a bead speed V_m (m/s) gives (Eq. 4/5), s."""
-    beads = get_material(config["material"])
-    force = force_from_bead_velocity(bead_speed_m_s, beads, config["radius_m"])
-    return float(pulse_half_width(force, beads, config["radius_m"]))
+    force = pulse_force(config, bead_speed_m_s)
+    return float(pulse_half_width(force, get_material(config["material"]), config["radius_m"]))
 
 
 def pulse_speed(config: Mapping, bead_speed_m_s: float) -> float:
     """Speed of the pulse a bead speed V_m (m/s) gives (Eq. 5), m/s."""
+    force = pulse_force(config, bead_speed_m_s)
     beads = get_material(config["material"])
-    force = force_from_bead_velocity(bead_speed_m_s, beads, config["radius_m"])
     return float(nesterenko_speed_from_force(force, beads, config["radius_m"]))
 
 
@@ -96,29 +84,10 @@ def check_multiple(path, interval: float, step: float, step_key: str) -> None:
         )
 
 
-def slowest_passing(config: Mapping, v0: float, sensors=None) -> dict:
-    """The chain where the wave of a bead launched at ``v0`` (m/s) passes its far sensor
-    last: :func:`chain.physics.theory.pulse_passing_time` and ``N``."""
-    return max(
-        (
-            pulse_passing_time(
-                config["material"],
-                config["radius_m"],
-                entry["N"],
-                sensors(entry) if sensors else entry["sensors"],
-                v0,
-            )
-            | {"N": entry["N"]}
-            for entry in config["chains"]
-        ),
-        key=lambda passing: passing["time_s"],
-    )
-
-
-def check_passing(config: Mapping, path, duration: float, v0: float, what, sensors=None):
+def check_passing(config: Mapping, path, duration: float, v0: float, what: str) -> None:
     """``duration`` (s) >= DURATION_MARGIN x the passing time of the slowest pulse, that
-    of bead 1 launched at ``v0`` (m/s), on every chain (``sensors``: entry -> beads)."""
-    worst = slowest_passing(config, v0, sensors)
+    of bead 1 launched at ``v0`` (m/s), on every chain; ``what`` names the launch."""
+    worst = slowest_passing(config, v0)
     needed = DURATION_MARGIN * worst["time_s"]
     if duration < needed:
         fail(
@@ -138,27 +107,25 @@ def sensor_room(entry: Mapping) -> tuple[float, float]:
 
 
 def _check_sensors(config: Mapping) -> None:
-    # chain.pipeline.config.check checks 1 <= S1 < S2 <= N; the analysis needs more: at S1 the
-    # incident LSTW, then the crossed RSTW (chain.analysis.pulse_rows), two pulses apart.
+    # check.py checks 1 <= S1 < S2 <= N; each sensor must also read two pulses apart.
     for i, entry in enumerate(config["chains"]):
         middle = collision_point(entry["N"])
         for j, room in enumerate(sensor_room(entry)):
             if room < MIN_SENSOR_DISTANCE:
-                side = "left" if j == 0 else "right"
+                side = ("left", "right")[j]
                 limit = middle - MIN_SENSOR_DISTANCE if j == 0 else middle + MIN_SENSOR_DISTANCE
+                allowed = f"S1 <= {limit:g}" if j == 0 else f"S2 >= {limit:g}"
                 fail(
                     ["chains", i, "sensors", j],
                     f"bead {entry['sensors'][j]} is {room:g} beads {side} of the collision "
                     f"point of the N = {entry['N']} chain (bead {middle:g}); the sensor reads "
                     f"the incident and the crossed pulse apart only from "
-                    f"{MIN_SENSOR_DISTANCE:g} beads away; allowed: "
-                    + (f"S1 <= {limit:g}" if j == 0 else f"S2 >= {limit:g}"),
+                    f"{MIN_SENSOR_DISTANCE:g} beads away; allowed: {allowed}",
                 )
 
 
 def _check_simulation(config: Mapping) -> None:
-    simulation = config["simulation"]
-    launch = config["launch"]
+    simulation, launch = config["simulation"], config["launch"]
     record, step = simulation["record_interval_s"], simulation.get("time_step_s")
     path = ["simulation", "record_interval_s"]
     if step is not None:
@@ -178,90 +145,64 @@ def _check_long_chains(config: Mapping) -> None:
     duration = config.get("long_chains", {}).get("duration_s")
     if duration is None:
         return
+    v0, what = config["launch"]["v0_min_m_s"], "bead 1 launched, to the middle bead"
     for n in config["long_chains"].get("N", []):
         middle = (n + 1) // 2
         long_chain = {**config, "chains": [{"N": n, "sensors": [middle, middle]}]}
-        check_passing(
-            long_chain,
-            ["long_chains", "duration_s"],
-            duration,
-            config["launch"]["v0_min_m_s"],
-            "bead 1 launched, to the middle bead",
-        )
+        check_passing(long_chain, ["long_chains", "duration_s"], duration, v0, what)
 
 
 def _check_lammps(config: Mapping) -> None:
     options = config["lammps"]
     step, record = options["time_step_s"], options["record_interval_s"]
-    check_multiple(["lammps", "record_interval_s"], record, step, "lammps.time_step_s")
+    path = ["lammps", "record_interval_s"]
+    check_multiple(path, record, step, "lammps.time_step_s")
     speeds = [*options["check_speeds_m_s"], *options["sweep"]["launch_speeds_m_s"]]
     fastest = LAUNCH_VELOCITY_RATIO * max(speeds)
-    check_resolution(
-        config, ["lammps", "record_interval_s"], record, fastest, f"bead 1 at {max(speeds):g} m/s"
-    )
+    check_resolution(config, path, record, fastest, f"bead 1 at {max(speeds):g} m/s")
     duration = options["duration_s"]
-    if duration < 10 * record:
-        fail(
-            ["lammps", "duration_s"],
-            f"{duration:g} s holds fewer than 10 samples of lammps.record_interval_s = "
-            f"{record:g} s; allowed: >= {10 * record:g} s",
-        )
+    check_samples(["lammps", "duration_s"], duration, record, "lammps.record_interval_s")
     check_passing(config, ["lammps", "duration_s"], duration, min(speeds), "bead 1 launched")
 
 
-def _check_friction_names(sweep: Mapping, base: list) -> None:
+def _check_setting_names(config: Mapping) -> None:
+    # Settings that file names (2 decimals; gamma 6 digits) would confuse.
+    sweep, base = config["lammps"]["sweep"], ["lammps", "sweep"]
+    frictionless = setting_name(0.0, 0.0)
     for key in ("track_friction", "bead_friction", "default_settings"):
         names: dict[str, object] = {}
         for i, value in enumerate(sweep[key]):
             pair = tuple(value) if key == "default_settings" else (value, value)
             name = setting_name(*pair)
-            if pair != (0, 0) and name == setting_name(0.0, 0.0):
+            if pair != (0, 0) and name == frictionless:
                 fail(
                     [*base, key, i],
                     f"{value} is named as the frictionless setting ({name}: file names keep "
                     "2 decimals); allowed: 0 or >= 0.005",
                 )
-            if name in names and names[name] != pair:
+            if names.setdefault(name, pair) != pair:
                 fail(
                     [*base, key, i],
                     f"{value} and {names[name]} share the file name {name} (2 decimals); "
                     "allowed: values at least 0.005 apart",
                 )
-            names[name] = pair
-
-
-def _check_setting_names(config: Mapping) -> None:
-    sweep = config["lammps"]["sweep"]
-    base = ["lammps", "sweep"]
-    _check_friction_names(sweep, base)
     sweep_settings(config, full=True)
     for key in ("default_viscous_N_s_per_m", "viscous_N_s_per_m"):
         seen: dict[str, float] = {}
         for i, gamma in enumerate(sweep[key]):
             name = viscous_name(float(gamma))
-            if name in seen and seen[name] != gamma:
+            if seen.setdefault(name, gamma) != gamma:
                 fail(
                     [*base, key, i],
                     f"{gamma} and {seen[name]} share the file name {name} (6 digits); "
                     "allowed: values apart in 6 significant digits",
                 )
-            seen[name] = gamma
 
 
 def check_run_bounds(config: Mapping) -> None:
-    """The bounds of the simulated run that need two keys (see the module docstring).
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in) that passed the checks of
-        :func:`chain.pipeline.config.check.check_config` before the bounds.
-
-    Raises
-    ------
-    ConfigError
-        Naming the first offending key.
-    """
+    """The bounds of the simulated run that need two keys (module docstring) in
+    ``config``, a schema-valid config that passed the checks before the bounds;
+    :class:`~chain.errors.ConfigError` naming the first offending key."""
     _check_sensors(config)
     _check_simulation(config)
     _check_long_chains(config)

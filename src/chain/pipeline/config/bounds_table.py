@@ -1,17 +1,17 @@
 """The table docs/config_bounds.md: every key of the config schema, its unit, smallest
 and largest usable value, and what else bounds it and why.
 
-The schema's own bounds (``minimum``, ``maxLength``, ``enum``...) fill the value
-columns; :data:`RULES` adds, per key, the bounds that need other keys
-(:mod:`chain.pipeline.config.check` and :mod:`chain.pipeline.config.bounds`), or says why a
-key has no upper bound. ``python -m chain.pipeline.config.bounds_table SCHEMA`` prints
-the table; a test checks that the committed one is that output, and that every key has
-a largest value or a rule.
+The schema's own bounds fill the value columns; :data:`RULES` adds the bounds that need
+other keys, or why a key has no upper bound. ``python -m chain.pipeline.config.bounds_table
+SCHEMA`` prints the table; a test keeps the committed one equal to it.
 """
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Mapping
+
+import yaml
 
 from chain.analysis.pulses import DEFAULT_MIN_SNR, MIN_FIT_SAMPLES
 from chain.pipeline.config.bounds_experiment import JITTER_SIGMAS, MIN_KEPT_SHOTS
@@ -164,18 +164,10 @@ RULES = {
     ),
 }
 
-_LOWER = {
-    "minimum": ">= {}",
-    "exclusiveMinimum": "> {}",
-    "minItems": "{} items",
-    "minLength": "{} characters",
-}
-_UPPER = {
-    "maximum": "<= {}",
-    "exclusiveMaximum": "< {}",
-    "maxItems": "{} items",
-    "maxLength": "{} characters",
-}
+#: Schema keywords of a key's smallest and largest value, as the table writes them.
+_LOWER = {"minimum": ">= {}", "exclusiveMinimum": "> {}", "minItems": "{} items"}
+_UPPER = {"maximum": "<= {}", "exclusiveMaximum": "< {}", "maxItems": "{} items"}
+_LOWER["minLength"] = _UPPER["maxLength"] = "{} characters"
 
 #: Written in the "largest" column of a choice (an enum or a boolean).
 CHOICE = "(a choice)"
@@ -219,13 +211,8 @@ def _unit(key: str, kind: str) -> str:
 
 
 def table_rows(schema: Mapping) -> list[tuple[str, str, str, str, str, str]]:
-    """(key, unit, type, smallest, largest, rule) of every leaf key of the schema.
-
-    Parameters
-    ----------
-    schema : mapping
-        The parsed ``workflow/schemas/config.schema.yaml``.
-    """
+    """(key, unit, type, smallest, largest, rule) of every leaf key of ``schema``, the
+    parsed ``workflow/schemas/config.schema.yaml``."""
     rows = []
     for key, sub in _leaves(schema):
         kind = sub.get("type", "as experiment.virtual" if "$ref" in sub else "")
@@ -244,13 +231,8 @@ def table_rows(schema: Mapping) -> list[tuple[str, str, str, str, str, str]]:
 
 
 def bounds_table(schema: Mapping) -> str:
-    """docs/config_bounds.md, from the schema and :data:`RULES` (:func:`table_rows`).
-
-    Parameters
-    ----------
-    schema : mapping
-        The parsed ``workflow/schemas/config.schema.yaml``.
-    """
+    """docs/config_bounds.md, from ``schema`` (the parsed config schema) and
+    :data:`RULES` (:func:`table_rows`)."""
     lines = [
         "# Config bounds",
         "",
@@ -271,10 +253,6 @@ def bounds_table(schema: Mapping) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m chain.pipeline.config.bounds_table SCHEMA``: print :func:`bounds_table`."""
-    import sys
-
-    import yaml
-
     path = (sys.argv[1:] if argv is None else argv)[0]
     with open(path, encoding="utf-8") as handle:
         sys.stdout.write(bounds_table(yaml.safe_load(handle)))

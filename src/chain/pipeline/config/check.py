@@ -1,85 +1,39 @@
 """Checks on a pipeline configuration that a JSON schema cannot express.
 
-The pipeline validates its config against ``workflow/schemas/config.schema.yaml``
-first (types, ranges, defaults; snakemake.utils.validate names the key as
-``On instance['chains'][1]['N']``), then calls :func:`check_config`: every number finite
-(:func:`check_finite`, one walk over the whole config: the schema's minimum/maximum let
-NaN through), then the relations between keys (sensor beads inside their chain, the
-Fig. 3 model among the models, a duration long enough for the waves, the virtual
-experiment's settings...), then :func:`chain.pipeline.plan.datasets.experiment_parts`
-reads the measured datasets' metadata and
-:func:`chain.pipeline.plan.datasets.check_experiment_datasets` checks every shot file of
-them. Every message starts with the dotted name of the offending key, e.g. ``config
-key 'chains[1].sensors': ...``, and says what is allowed, so that a bad config stops
-before any job runs and says where.
+After the schema (types, ranges, defaults), :func:`check_config` checks that every number
+is finite, the relations between keys, then the bounds that need a second key
+(:mod:`chain.pipeline.config.bounds`). Every message starts with the dotted key (``config
+key 'chains[1].sensors': ...``) and says what is allowed, so that a bad config stops before
+any job runs and says where. A plain dict in; no file read, no Snakemake.
 
-:func:`check_config` takes a plain dict, reads no file and knows no Snakemake. What a
-checked config means for the run (speeds, chains, jobs, targets) is derived once, by
-:class:`chain.pipeline.plan.run_plan.RunPlan`.
-
-Duration check
---------------
-A record must be long enough for the slowest wave to pass the sensor farthest from
-its launching end (S2 for the LSTW, S1 for the RSTW): at distance
-d = 2R max(S2 - 1, N - S1), the whole pulse has passed at d / v + (pi/2) tau, with v
-the solitary-wave speed of Eq. 5 and tau = R sqrt(10) / v (Eq. 4) for the smallest
-incident amplitude. That amplitude is estimated from the launch momentum:
-
-* simulation (bead 1 launched at V0): F_m = F(V_m) of Eq. 5 with
-  V_m = :data:`LAUNCH_VELOCITY_RATIO` x V0 (measured 0.47 in the paper's chains: F_m =
-  1030 N at V0 = 1 m/s; the ratio is the same for every material and radius by the
-  scaling symmetry of the Hertz chain);
-* virtual experiment (strikers, or ``launch: bead``): checked in
-  :mod:`chain.pipeline.config.bounds_experiment`, from the launch's momentum.
-
-The duration must exceed :data:`DURATION_MARGIN` times that time. The paper run passes
-with 2.6 ms against 1.9 ms (simulation, 0.021 m/s, N = 26). The SSW search after the
-crossed pulse (6 tau) is cut at the end of the record when it is shorter; that is not
-an error.
+Duration: a record must last :data:`DURATION_MARGIN` times the time the slowest wave
+(bead 1 launched at ``launch.v0_min_m_s``) needs to pass the sensor farthest from its
+launching end (:func:`chain.physics.theory.pulse_passing_time`). The paper run passes with
+2.6 ms against 1.9 ms; the SSW search is cut at the end of a shorter record.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
-from chain.errors import ConfigError, ParameterError, nonfinite_paths
-from chain.errors import key_label as key_name
+from chain.errors import ConfigError, ParameterError, key_label, nonfinite_paths
 from chain.physics.materials import MATERIALS, get_material
-from chain.physics.theory import (
-    LAUNCH_VELOCITY_RATIO,
-    force_from_bead_velocity,
-    pulse_passing_time,
-)
+from chain.physics.theory import force_from_bead_velocity
+from chain.pipeline.config import check_samples, fail, launch_ratios, slowest_passing
 from chain.pipeline.config.ablation import check_ablation
 from chain.pipeline.config.virtual import virtual_experiment
 
-#: The duration must be this many times the time the slowest pulse needs to pass the
-#: far sensor (see the module docstring).
+#: The duration over the time the slowest pulse needs to pass the far sensor, at least.
 DURATION_MARGIN = 1.2
 
 
-def _fail(path, message: str):
-    raise ConfigError(f"config key {key_name(path)!r}: {message}")
-
-
-def _check_duration(path, duration, config, v0, mass_ratio, what) -> None:
-    worst = None
-    for entry in config["chains"]:
-        passing = pulse_passing_time(
-            config["material"], config["radius_m"], entry["N"], entry["sensors"], v0, mass_ratio
-        )
-        if worst is None or passing["time_s"] > worst[1]["time_s"]:
-            worst = (entry["N"], passing)
-    n, passing = worst
-    needed = DURATION_MARGIN * passing["time_s"]
-    if duration < needed:
-        _fail(
+def _check_step(path, step, interval: float, interval_key: str) -> None:
+    if step is not None and step > interval:
+        what = interval_key.removesuffix("_s").replace("_", " ")
+        fail(
             path,
-            f"{duration:g} s is too short: the slowest wave ({what} at V0 = {v0:g} m/s: F_m ~ "
-            f"{passing['force_N']:.3g} N, Eq. 5 speed {passing['speed_m_s']:.0f} m/s) has "
-            f"passed bead {passing['bead']} of the N = {n} chain, {passing['distance_m']:.3g} m "
-            f"from its launching end, at ~{passing['time_s'] * 1e3:.3g} ms; allowed: >= "
-            f"{DURATION_MARGIN:g} x that = {needed:.3g} s (or faster launches)",
+            f"{step:g} s is longer than {interval_key} = {interval:g} s; allowed: <= the {what}, "
+            "or null",
         )
 
 
@@ -87,97 +41,56 @@ def _check_sources(experiment: Mapping) -> None:
     source = experiment.get("source", "none")
     datasets = experiment.get("datasets", [])
     if source == "measured" and not datasets:
-        _fail(
+        fail(
             ["experiment", "datasets"],
             "source: measured needs at least one dataset folder (data/README.md format), "
             "e.g. [data/lab2011_N25, data/lab2011_N26]",
         )
     if source != "measured" and datasets:
-        _fail(
+        fail(
             ["experiment", "datasets"],
             f"dataset folders are read only with source: measured (source is {source!r}); "
             "empty the list or set experiment.source: measured",
         )
 
 
-def _check_virtual_keys(virtual: Mapping, base: list) -> None:
+def _check_virtual(config: Mapping) -> None:
+    virtual = config.get("experiment", {}).get("virtual", {})
+    base = ["experiment", "virtual"]
     if virtual.get("impact_speeds_m_s") is not None and virtual.get("drop_heights_m") is not None:
-        _fail(
+        fail(
             [*base, "drop_heights_m"],
             "give impact_speeds_m_s or drop_heights_m, not both (set the other to null)",
         )
-    duration = virtual.get("duration_s", 0.0)
     sampling = virtual.get("sampling_interval_s", 1.0)
-    if duration < 10 * sampling:
-        _fail(
-            [*base, "duration_s"],
-            f"{duration:g} s holds fewer than 10 samples of sampling_interval_s = {sampling:g} s; "
-            f"allowed: >= {10 * sampling:g} s",
-        )
-    step = virtual.get("time_step_s")
-    if step is not None and step > sampling:
-        _fail(
-            [*base, "time_step_s"],
-            f"{step:g} s is longer than sampling_interval_s = {sampling:g} s; allowed: "
-            "<= the sampling interval, or null",
-        )
-
-
-def _virtual_settings_of_chains(config: Mapping, base: list):
-    settings = None
+    key = "sampling_interval_s"
+    check_samples([*base, "duration_s"], virtual.get("duration_s", 0.0), sampling, key)
+    _check_step([*base, "time_step_s"], virtual.get("time_step_s"), sampling, key)
     for entry in config["chains"]:
         try:
             settings = virtual_experiment(config, entry["N"], entry["sensors"])
         except ParameterError as error:
-            _fail(base, f"{error} (chain N = {entry['N']})")
-    return settings
-
-
-def _check_virtual(config: Mapping) -> None:
-    virtual = config.get("experiment", {}).get("virtual", {})
-    base = ["experiment", "virtual"]
-    _check_virtual_keys(virtual, base)
-    settings = _virtual_settings_of_chains(config, base)
-    speeds = settings.nominal_speeds
-    beads = get_material(config["material"])
-    # launch: bead sets bead 1 itself moving at V0 (the simulation's launch): m_s / m = 1.
-    bead_launch = settings.launch == "bead"
-    mass_ratio = 1.0 if bead_launch else (settings.striker_radius / settings.radius) ** 3
-    # Largest pulse: a launcher that bounces back elastically hands the chain at most
-    # 2 m_s m / (m_s + m) V0 (2 m_s V0 for a light striker, m V0 for a launched bead).
-    v_m = LAUNCH_VELOCITY_RATIO * 2.0 * mass_ratio / (1.0 + mass_ratio) * float(max(speeds))
-    largest = force_from_bead_velocity(v_m, beads, config["radius_m"])
+            fail(base, f"{error} (chain N = {entry['N']})")
+    # The largest pulse: that of the fastest launch, handed on whole.
+    fastest = float(max(settings.nominal_speeds))
+    v_m = launch_ratios(config, virtual)[1] * fastest
+    largest = force_from_bead_velocity(v_m, get_material(config["material"]), config["radius_m"])
     volts = largest * max(settings.sensitivities) / 1000.0
     if settings.adc_bits is not None and volts >= settings.adc_range_V:
-        _fail(
+        fail(
             [*base, "adc_range_V"],
             f"{settings.adc_range_V:g} V: the largest pulse (~{largest:.3g} N at "
-            f"{max(speeds):g} m/s) reads ~{volts:.3g} V and would saturate the ADC; allowed: "
+            f"{fastest:g} m/s) reads ~{volts:.3g} V and would saturate the ADC; allowed: "
             f"> {volts:.3g} V (or slower strikers, or adc_bits: null)",
         )
 
 
-def _check_experiment(config: Mapping) -> None:
-    experiment = config.get("experiment", {})
-    _check_sources(experiment)
-    if experiment.get("source", "none") == "virtual":
-        _check_virtual(config)
-
-
 def check_finite(config: Mapping) -> None:
-    """Every number of a config is finite, or :class:`ConfigError` naming each key.
-
-    One walk over the whole config rather than a rule per key: the JSON schema's
-    minimum/maximum let NaN through (comparisons with NaN are false), and YAML spells
-    NaN and infinity ``.nan`` and ``.inf``.
-
-    Parameters
-    ----------
-    config : mapping
-        A config, validated or not.
-    """
+    """Every number of ``config`` (a mapping, validated or not) is finite, else
+    :class:`ConfigError` naming each key: the schema's minimum/maximum let NaN through,
+    and YAML spells NaN and infinity ``.nan`` and ``.inf``."""
     bad = [
-        f"config key {key_name(path)!r}: {number!r} is not a finite number; allowed: a "
+        f"config key {key_label(path)!r}: {number!r} is not a finite number; allowed: a "
         "finite number in the key's range (workflow/schemas/config.schema.yaml)"
         for path, number in nonfinite_paths(dict(config))
     ]
@@ -190,7 +103,7 @@ def _check_chains(config: Mapping) -> dict[int, int]:
     for i, entry in enumerate(config["chains"]):
         n = entry["N"]
         if n in seen_n:
-            _fail(
+            fail(
                 ["chains", i, "N"],
                 f"N = {n} is listed twice (also chains[{seen_n[n]}]); allowed: each N once",
             )
@@ -198,18 +111,18 @@ def _check_chains(config: Mapping) -> dict[int, int]:
         s1, s2 = entry["sensors"]
         for j, bead in enumerate((s1, s2)):
             if not 1 <= bead <= n:
-                _fail(
+                fail(
                     ["chains", i, "sensors", j],
                     f"bead {bead} is outside the chain; allowed: beads 1..{n}",
                 )
         if not s1 < s2:
-            _fail(
+            fail(
                 ["chains", i, "sensors"],
                 f"got {[s1, s2]}; allowed: S1 left of S2 (S1 < S2; S1 is met first by the LSTW)",
             )
     for i, n in enumerate(config.get("long_chains", {}).get("N", [])):
         if n in seen_n:
-            _fail(
+            fail(
                 ["long_chains", "N", i],
                 f"N = {n} is also chains[{seen_n[n]}] (their files would clash); allowed: "
                 "an N not in chains",
@@ -221,19 +134,19 @@ def _check_models_and_launch(config: Mapping) -> list[str]:
     names = [m["name"] for m in config["models"]]
     for i, name in enumerate(names):
         if name in names[:i]:
-            _fail(
+            fail(
                 ["models", i, "name"],
                 f"model name {name!r} is listed twice; allowed: each name once (file names)",
             )
     launch = config["launch"]
     if launch["v0_min_m_s"] > launch["v0_max_m_s"]:
-        _fail(
+        fail(
             ["launch", "v0_min_m_s"],
             f"{launch['v0_min_m_s']} m/s is above v0_max_m_s = {launch['v0_max_m_s']} m/s; "
             "allowed: v0_min_m_s <= v0_max_m_s",
         )
     if launch["count"] > 1 and launch["v0_min_m_s"] == launch["v0_max_m_s"]:
-        _fail(
+        fail(
             ["launch", "count"],
             f"{launch['count']} launch speeds need v0_min_m_s < v0_max_m_s; allowed: a "
             "smaller v0_min_m_s (count is at least 3: the free exponent needs 3 speeds)",
@@ -243,84 +156,76 @@ def _check_models_and_launch(config: Mapping) -> list[str]:
 
 def _check_simulation(config: Mapping) -> None:
     simulation = config.get("simulation", {})
-    step = simulation.get("time_step_s")
-    record = simulation.get("record_interval_s")
-    if step is not None and record is not None and step > record:
-        _fail(
-            ["simulation", "time_step_s"],
-            f"{step:g} s is longer than record_interval_s = {record:g} s; allowed: <= the "
-            "record interval, or null",
-        )
-    duration = simulation.get("duration_s")
-    if duration is not None and record is not None and duration < 10 * record:
-        _fail(
-            ["simulation", "duration_s"],
-            f"{duration:g} s holds fewer than 10 samples of record_interval_s = {record:g} s; "
-            f"allowed: >= {10 * record:g} s",
-        )
-    if duration is not None:
-        _check_duration(
-            ["simulation", "duration_s"],
-            duration,
-            config,
-            config["launch"]["v0_min_m_s"],
-            1.0,
-            "bead 1 launched",
+    record, duration = simulation.get("record_interval_s"), simulation.get("duration_s")
+    path = ["simulation", "duration_s"]
+    if record is not None:
+        step = simulation.get("time_step_s")
+        _check_step(["simulation", "time_step_s"], step, record, "record_interval_s")
+        if duration is not None:
+            check_samples(path, duration, record, "record_interval_s")
+    if duration is None:
+        return
+    v0 = config["launch"]["v0_min_m_s"]
+    passing = slowest_passing(config, v0)
+    needed = DURATION_MARGIN * passing["time_s"]
+    if duration < needed:
+        fail(
+            path,
+            f"{duration:g} s is too short: the slowest wave (bead 1 launched at V0 = {v0:g} "
+            f"m/s: F_m ~ {passing['force_N']:.3g} N, Eq. 5 speed {passing['speed_m_s']:.0f} "
+            f"m/s) has passed bead {passing['bead']} of the N = {passing['N']} chain, "
+            f"{passing['distance_m']:.3g} m from its launching end, at "
+            f"~{passing['time_s'] * 1e3:.3g} ms; allowed: >= {DURATION_MARGIN:g} x that = "
+            f"{needed:.3g} s (or faster launches)",
         )
 
 
 def _check_analysis_and_figures(config: Mapping, names: list[str], seen_n) -> None:
     analysis = config.get("analysis", {})
     if analysis.get("main_estimator") not in analysis.get("estimators", [None]):
-        _fail(
+        fail(
             ["analysis", "main_estimator"],
             f"{analysis.get('main_estimator')!r} is not among analysis.estimators; allowed: "
             f"{analysis.get('estimators')}",
         )
     figures = config.get("figures", {})
     if figures.get("traces_model") not in names:
-        _fail(
+        fail(
             ["figures", "traces_model"],
             f"{figures.get('traces_model')!r} is not a configured model; allowed: {names}",
         )
     for j, n in enumerate(figures.get("traces_N") or []):
         if n not in seen_n:
-            _fail(
+            fail(
                 ["figures", "traces_N", j],
                 f"N = {n} is not a configured chain; allowed: {sorted(seen_n)}",
             )
     index = figures.get("representative_index")
     count = config["launch"]["count"]
     if index is not None and index >= count:
-        _fail(
+        fail(
             ["figures", "representative_index"],
             f"{index} is not an amplitude index; allowed: 0..{count - 1} (launch.count speeds)",
         )
 
 
 def check_config(config: Mapping) -> None:
-    """Check a schema-valid config: every number finite, then the relations between keys.
-
-    Parameters
-    ----------
-    config : mapping
-        The config after schema validation (defaults filled in).
-
-    Raises
-    ------
-    ConfigError
-        Naming every non-finite key, else the first offending key.
-    """
+    """Check ``config``, validated by the schema (defaults filled in): every number
+    finite, then the relations between keys; :class:`ConfigError` naming every
+    non-finite key, else the first offending key."""
     check_finite(config)
     if config["material"] not in MATERIALS:
         known = ", ".join(sorted(MATERIALS))
-        _fail(["material"], f"unknown material {config['material']!r}; known: {known}")
+        fail(["material"], f"unknown material {config['material']!r}; known: {known}")
     seen_n = _check_chains(config)
     names = _check_models_and_launch(config)
     _check_simulation(config)
     _check_analysis_and_figures(config, names, seen_n)
-    _check_experiment(config)
-    from chain.pipeline.config.bounds import check_bounds
-
+    experiment = config.get("experiment", {})
+    _check_sources(experiment)
+    if experiment.get("source", "none") == "virtual":
+        _check_virtual(config)
     check_ablation(config)
-    check_bounds(config, check_config)  # chain.pipeline.config.bounds: bounds needing 2 keys
+    from chain.pipeline.config.bounds import check_bounds  # imports pandas: only here
+
+    check_bounds(config, check_config)

@@ -1,19 +1,15 @@
 """The pipeline's config files as text: YAML mistakes named by file and line.
 
-Snakemake reports a config file it cannot parse as "Config file is not valid JSON or
-YAML", without the file or the line, and a key given twice silently keeps the last
-value. :func:`check_config_files` reads the files before Snakemake does (the main
-``config.yaml``) or again after it (the ``--configfile`` overlays, which Snakemake
-parses before the Snakefile runs) and names both.
-
-An overlay that is not valid YAML at all stops Snakemake before the Snakefile runs, with
-Snakemake's own message (``--verbose`` shows the parser's, with file and line);
-``python -m chain.pipeline.config.files whatif/x.yaml`` names them too.
+Snakemake reports a config file it cannot parse without file or line, and a key given
+twice silently keeps the last value. An overlay that is not YAML at all stops Snakemake
+before the Snakefile runs; ``python -m chain.pipeline.config.files whatif/x.yaml`` names
+file and line.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -31,25 +27,18 @@ class _StrictLoader(yaml.SafeLoader):
             key = self.construct_object(key_node, deep=True)
             line = key_node.start_mark.line + 1
             if key in seen:
-                raise yaml.constructor.ConstructorError(
-                    None,
-                    None,
+                problem = (
                     f"key {key!r} is given twice (lines {seen[key]} and {line}); YAML would "
-                    "keep only the last",
-                    key_node.start_mark,
+                    "keep only the last"
                 )
+                raise yaml.constructor.ConstructorError(None, None, problem, key_node.start_mark)
             seen[key] = line
         return super().construct_mapping(node, deep=deep)
 
 
 def check_config_file(path: str | os.PathLike) -> None:
-    """Parse one config file; raise :class:`ConfigError` naming the file and line.
-
-    Parameters
-    ----------
-    path : path
-        A YAML (or JSON) config file, the main one or an overlay.
-    """
+    """Parse the config file ``path`` (YAML or JSON, the main one or an overlay); raise
+    :class:`ConfigError` naming the file and line of a mistake."""
     try:
         text = Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -70,18 +59,14 @@ def check_config_file(path: str | os.PathLike) -> None:
 
 
 def check_config_files(paths: Iterable[str | os.PathLike]) -> None:
-    """:func:`check_config_file` on each of ``paths`` (missing optional files skipped
-    by the caller)."""
+    """:func:`check_config_file` on each of ``paths`` (config files)."""
     for path in paths:
         check_config_file(path)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m chain.pipeline.config.files FILE...``: name the file and line of a YAML
-    mistake in config files (Snakemake parses ``--configfile`` overlays before the
-    Snakefile runs, and its own message names neither)."""
-    import sys
-
+    """``python -m chain.pipeline.config.files FILE...``: name the file and line of each
+    YAML mistake in the config files ``argv`` (default the command line's); 1 if any."""
     status = 0
     for path in sys.argv[1:] if argv is None else argv:
         try:

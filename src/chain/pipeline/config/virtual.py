@@ -1,10 +1,6 @@
-"""The virtual experiment's settings from a config: ``experiment.virtual`` as it is
-(its keys are the fields of :class:`chain.apparatus.virtual.VirtualExperiment`), plus
-the run's material, radius, striker and seed, and the chain.
-
-Its own module so that both :mod:`chain.pipeline.config.check` (the checks) and
-:mod:`chain.pipeline.config.ablation` (the variants) use it without importing each other.
-"""
+"""The virtual experiment's settings from a config: ``experiment.virtual`` as it is (its
+keys are the fields of VirtualExperiment), plus the run's material, radius, striker and
+seed, and the chain. Shared by the checks and the ablation variants."""
 
 from __future__ import annotations
 
@@ -13,31 +9,17 @@ from dataclasses import fields
 
 from chain.apparatus.virtual_settings import VirtualExperiment
 
-#: Fields of VirtualExperiment that the run sets (the chain, material, radius, striker,
-#: seed); every other field is a key of ``experiment.virtual``.
+#: Fields of VirtualExperiment that the run sets; every other one is a key of
+#: ``experiment.virtual``, in order (:data:`VIRTUAL_KEYS`).
 RUN_FIELDS = ("n_beads", "sensor_beads", "material", "radius", "striker_radius", "seed")
-
-#: The keys of ``experiment.virtual``: the other fields of VirtualExperiment, in order.
 VIRTUAL_KEYS = tuple(f.name for f in fields(VirtualExperiment) if f.name not in RUN_FIELDS)
 
 
 def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence[int]) -> dict:
-    """The :class:`~chain.apparatus.virtual.VirtualExperiment` fields of one chain of a
-    config, as plain values (lists for tuples).
-
-    Material and radius are the run's, the striker radius ``setup.striker_radius_m``,
-    the seed the top-level seed + N (so that the chains' shots differ), the rest
-    ``experiment.virtual`` under its own names.
-
-    Parameters
-    ----------
-    config : mapping
-        A schema-valid config (defaults filled in).
-    n_beads : int
-        N.
-    sensors : sequence of int
-        Sensor beads [S1, S2].
-    """
+    """The VirtualExperiment fields, as plain values, of the chain of ``n_beads`` beads
+    and ``sensors`` [S1, S2] of the schema-valid ``config``: its material and radius (m),
+    ``setup.striker_radius_m``, the seed + N (the chains' shots differ), and
+    ``experiment.virtual`` under its own names."""
     return {
         **config["experiment"]["virtual"],
         "n_beads": int(n_beads),
@@ -51,11 +33,5 @@ def virtual_experiment_settings(config: Mapping, n_beads: int, sensors: Sequence
 
 def virtual_experiment(config: Mapping, n_beads: int, sensors: Sequence[int]) -> VirtualExperiment:
     """The virtual experiment of one chain of a config (parameters as
-    :func:`virtual_experiment_settings`).
-
-    Raises
-    ------
-    chain.errors.ParameterError
-        Naming the field the virtual experiment refuses.
-    """
+    :func:`virtual_experiment_settings`); ParameterError naming a field it refuses."""
     return VirtualExperiment(**virtual_experiment_settings(config, n_beads, sensors))

@@ -1,22 +1,10 @@
 """The experiment's parts (chains and their datasets) and labels, and the measured
 datasets a config uses, checked before any job runs.
 
-:func:`experiment_parts` gives the chains of the experiment (one per configured chain
-for the virtual experiment, one per dataset folder for measured data, read from its
-``metadata.yaml``) and :func:`experiment_label` how figures and the summary name them.
-
-:func:`check_experiment_datasets` runs :func:`chain.apparatus.dataset_check.check_dataset`
-on every dataset folder of ``experiment.datasets`` when the pipeline builds its DAG, and
-stops with one :class:`~chain.errors.ConfigError` that lists every problem of
-every dataset (up to a limit each), one console line per problem: file, line, column,
-what was expected. Shots with a dead or saturated channel stop the run too, unless
-``experiment.bad_channels: skip``; then :func:`skipped_shot_rows` gives the rows that
-``experiment/selection.csv`` lists them with (kept False, the channel as the reason),
-so the summary counts them among the rejected shots.
-
-The check's verdicts are kept in :data:`DEFAULT_CACHE`, a folder named by a digest of
-the code that makes them (:func:`check_code_digest`): an edit of that code starts an
-empty folder, and the check's code needs no version to bump.
+Every problem of every shot file is listed at once (file, line, column, what was
+expected). With ``experiment.bad_channels: skip``, shots with a dead or saturated channel
+are left out, and listed as rejected (:func:`skipped_shot_rows`). The verdicts are cached
+in a folder named by a digest of the check's code (:data:`DEFAULT_CACHE`).
 """
 
 from __future__ import annotations
@@ -34,8 +22,7 @@ import pandas as pd
 from chain.analysis.selection import SELECTION_COLUMNS
 from chain.apparatus.dataset_check import DatasetCheck, check_dataset
 from chain.apparatus.measured import MeasuredDataError, read_metadata, usable_shots
-from chain.errors import ConfigError
-from chain.errors import key_label as key_name
+from chain.errors import ConfigError, key_label
 from chain.labels import SKIPPED_REASON, VIRTUAL_LABEL, VIRTUAL_SERIES
 from chain.pipeline.plan.code import module_sources
 
@@ -45,14 +32,9 @@ PACKAGE_DIR = Path(__file__).resolve().parents[2]
 
 
 def check_code_digest(package_dir: str | os.PathLike = PACKAGE_DIR) -> str:
-    """SHA-256 (hex) of the code of the dataset check: every file of the package that
-    importing :data:`CHECK_MODULE` runs, each with its path in the package.
-
-    Parameters
-    ----------
-    package_dir : path
-        The ``chain`` package folder (by default this one's).
-    """
+    """SHA-256 (hex) of the code of the dataset check: every file of the package
+    ``package_dir`` (the ``chain`` folder) that importing :data:`CHECK_MODULE` runs, each
+    with its path in the package."""
     digest = hashlib.sha256()
     for path in module_sources(CHECK_MODULE, package_dir):
         name = path.relative_to(Path(package_dir).resolve()).as_posix()
@@ -60,8 +42,7 @@ def check_code_digest(package_dir: str | os.PathLike = PACKAGE_DIR) -> str:
     return digest.hexdigest()
 
 
-#: Where the pipeline keeps the verdicts of the dataset check (by file content), one
-#: folder per version of the check's code.
+#: Where the pipeline keeps the dataset check's verdicts, a folder per version of its code.
 DEFAULT_CACHE = Path(".snakemake") / "hertzchain" / f"dataset-check-{check_code_digest()[:16]}"
 
 #: Series names usable in file names (experiment/<name>_N<N>_traces.csv).
@@ -69,62 +50,33 @@ SERIES_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
 
 def _fail(path, message: str):
-    raise ConfigError(f"config key {key_name(path)!r}: {message}")
+    raise ConfigError(f"config key {key_label(path)!r}: {message}")
 
 
 @dataclass(frozen=True)
 class ExperimentPart:
-    """One chain of the experiment: where its traces come from.
+    """One chain of the experiment: where its traces come from."""
 
-    Attributes
-    ----------
-    name : str
-        Series name (the ``model`` column; chains of one name are pooled in the fits).
-    n_beads : int
-        N.
-    sensor_beads : tuple of int
-        Sensor beads, S1 first.
-    folder : str or None
-        The measured dataset folder; None for the virtual experiment (its folder is a
-        pipeline output).
-    files : tuple of str
-        ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
-    virtual : bool
-        Whether the traces come from the virtual experiment (a model, not data),
-        including a measured-format dataset that it wrote.
-    """
-
+    #: Series name (the ``model`` column; chains of one name are pooled in the fits).
     name: str
     n_beads: int
+    #: Sensor beads, S1 first.
     sensor_beads: tuple[int, ...]
+    #: The measured dataset folder; None for the virtual experiment (a pipeline output).
     folder: str | None = None
+    #: ``metadata.yaml`` and the shot files of a measured dataset (empty for virtual).
     files: tuple[str, ...] = ()
+    #: Whether the traces come from the virtual experiment (a model, not data), a
+    #: measured-format dataset that it wrote included.
     virtual: bool = True
 
 
 def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[ExperimentPart]:
-    """The chains of a config's experiment, reading measured datasets' metadata.
-
-    Parameters
-    ----------
-    config : mapping
-        A config that passed :func:`chain.pipeline.config.check.check_config`.
-    root : path
-        Folder that relative dataset paths start from (the working directory).
-
-    Returns
-    -------
-    list of ExperimentPart
-        Empty with ``experiment.source: none``; one per configured chain for the
-        virtual experiment; one per dataset for measured datasets.
-
-    Raises
-    ------
-    ConfigError
-        Naming ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong
-        (the loader's message, with file and line), its name is not usable in file
-        names, or two datasets give the same name and N.
-    """
+    """The chains of the experiment of ``config`` (checked): none with ``experiment.source:
+    none``, one per configured chain for the virtual experiment, one per measured dataset
+    (read from its metadata; relative folders start from ``root``); ConfigError naming
+    ``experiment.datasets[i]`` when a dataset's metadata is missing or wrong, its name
+    unusable in file names, or its name and N those of another."""
     experiment = config.get("experiment", {})
     source = experiment.get("source", "none")
     name = experiment.get("name")
@@ -139,7 +91,7 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
     seen: dict[tuple[str, int], int] = {}
     for i, folder in enumerate(experiment.get("datasets", [])):
         path = ["experiment", "datasets", i]
-        where = Path(folder) if Path(folder).is_absolute() else Path(root) / folder
+        where = Path(root) / folder  # an absolute folder as it is
         try:
             meta = read_metadata(where)
         except MeasuredDataError as error:
@@ -160,30 +112,18 @@ def experiment_parts(config: Mapping, root: str | os.PathLike = ".") -> list[Exp
                 f"experiment.datasets[{seen[key]}]); allowed: one dataset per name and N",
             )
         seen[key] = i
-        parts.append(
-            ExperimentPart(
-                name=series,
-                n_beads=meta.n_beads,
-                sensor_beads=tuple(meta.sensor_beads),
-                folder=str(folder),
-                files=(
-                    str(Path(folder) / "metadata.yaml"),
-                    *(str(Path(folder) / shot.file) for shot in meta.shots),
-                ),
-                virtual=VIRTUAL_LABEL in (meta.description or ""),
-            )
-        )
+        listed = ("metadata.yaml", *(shot.file for shot in meta.shots))
+        files = tuple(str(Path(folder) / file) for file in listed)
+        virtual = VIRTUAL_LABEL in (meta.description or "")
+        beads = tuple(meta.sensor_beads)
+        parts.append(ExperimentPart(series, meta.n_beads, beads, str(folder), files, virtual))
     return parts
 
 
 def experiment_label(parts: Sequence[ExperimentPart]) -> str:
-    """How figures and the summary name the experiment series.
-
-    ``"virtual experiment (model)"`` for the virtual experiment run by the pipeline;
-    ``"measured (<names>)"`` for measured datasets, and ``"virtual experiment (model):
-    <names>"`` for a measured-format dataset that the virtual experiment wrote (it is
-    still not data).
-    """
+    """How figures and the summary name the series of ``parts`` (:func:`experiment_parts`):
+    ``"virtual experiment (model)"``, ``"measured (<names>)"``, or ``"virtual experiment
+    (model): <names>"`` for a dataset the virtual experiment wrote (still not data)."""
     if not parts:
         return "experiment"
     if all(part.folder is None for part in parts):
@@ -205,61 +145,34 @@ def check_experiment_datasets(
     root: str | os.PathLike = ".",
     cache_dir: str | os.PathLike | None = DEFAULT_CACHE,
 ) -> None:
-    """Check every measured dataset of a config's experiment; raise listing all problems.
-
-    Parameters
-    ----------
-    config : mapping
-        A config that passed :func:`chain.pipeline.config.check.check_config`.
-    parts : sequence of ExperimentPart
-        :func:`experiment_parts` of it (virtual parts, whose
-        datasets are pipeline outputs, are skipped).
-    root : path
-        Folder that relative dataset paths start from.
-    cache_dir : path or None
-        Verdict cache (relative paths start from ``root``), made private (0700); the
-        folders beside it named ``dataset-check*`` (verdicts of other versions of the
-        check's code) are removed. None checks every file.
-
-    Raises
-    ------
-    ConfigError
-        ``experiment.datasets: N problems in M datasets`` then one line per problem.
-    """
+    """Check every measured dataset of ``parts`` (:func:`experiment_parts` of the checked
+    ``config``; relative folders start from ``root``); ConfigError listing all problems.
+    ``cache_dir`` keeps the verdicts (relative to ``root``; private, 0700; the folders of
+    other versions of the check's code beside it are removed); None checks every file."""
     policy = bad_channel_policy(config)
     cache = None if cache_dir is None else Path(root) / cache_dir
     for old in [] if cache is None else cache.parent.glob("dataset-check*"):
         if old != cache and old.is_dir():
             shutil.rmtree(old, ignore_errors=True)
-    messages, bad = [], 0
+    messages = []
     for part in parts:
-        if part.folder is None:
-            continue
-        folder = Path(part.folder)
         try:
-            usable_shots(check_dataset(Path(root) / folder, cache_dir=cache), policy)
+            if part.folder is not None:
+                usable_shots(check_dataset(Path(root) / part.folder, cache_dir=cache), policy)
         except MeasuredDataError as error:
             messages.append(str(error))
-            bad += 1
     if messages:
         raise ConfigError(
-            f"config key 'experiment.datasets': {bad} of {len(parts)} datasets cannot be "
+            f"config key 'experiment.datasets': {len(messages)} of {len(parts)} datasets cannot be "
             "used (data/README.md; every problem below, up to 20 per dataset):\n"
             + "\n".join(messages)
         )
 
 
 def skipped_shot_rows(check: DatasetCheck, name: str) -> pd.DataFrame:
-    """Selection rows (:data:`chain.analysis.selection.SELECTION_COLUMNS`) of the shots
-    of a dataset left out for a dead or saturated channel, the channel as the reason.
-
-    Parameters
-    ----------
-    check : DatasetCheck
-        :func:`chain.apparatus.dataset_check.check_dataset` of the dataset.
-    name : str
-        Series name of the dataset (the ``model`` column).
-    """
+    """Selection rows (:data:`chain.analysis.selection.SELECTION_COLUMNS`) of the shots a
+    dataset's ``check`` (:func:`~chain.apparatus.dataset_check.check_dataset`) left out for
+    a dead or saturated channel, the channel as the reason; ``name``: its series."""
     rows = [
         {
             "source": "experiment",

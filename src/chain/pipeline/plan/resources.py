@@ -1,39 +1,15 @@
 """What a simulation job asks a batch scheduler for: memory (MB) and run time (minutes).
 
-A SLURM job is killed when it passes its memory or time request, and waits longer in
-the queue the more it asks, so the simulate rule asks for what its chain needs
-(``workflow/rules/common.smk`` calls :func:`simulation_needs` per job).
+A SLURM job is killed when it passes its request, and waits longer the more it asks.
 
-How the memory was estimated
-----------------------------
-The integrator keeps every recorded sample of every particle of a batch of B launches:
-forces and velocities, (B, S, P) arrays with S = duration / record_interval samples,
-copied once more into the per-bead view, then read out into a trace table. The peak
-resident memory of the simulate script, measured (``resource.getrusage``, numba
-threads 2) for N = 16..100 beads, 4..24 launch speeds and 1.5..5.2 ms, is
+Memory: the integrator keeps every recorded sample of every particle of a batch of B
+launches. The simulate script's peak, measured for N = 16..100, 4..24 launch speeds and
+1.5..5.2 ms, is 200 MB + (48 N + 80) bytes x B x S (S samples) within 10 MB; with an
+empty numba cache, compiling the kernels peaks at ~590 MB first: the request's base.
 
-    peak ~ 200 MB + (48 N + 80) bytes x B x S
-
-within 10 MB (200 MB: Python, numpy, pandas, numba and the cached kernels; 48 bytes =
-six float64 per particle and sample). The first job after a fresh clone or a kernel
-edit compiles the numba kernels instead of loading them from the cache, and that
-compilation peaks at about 590 MB before any trace is allocated (measured, N = 40):
-the base of the request is that compile peak, so a job never dies of an empty cache.
-Warm, the paper's N = 26, 12 speeds, 2.6 ms peaks at
-240 MB; N = 100, 24 speeds, 5.2 ms at 790 MB. A cluster job also holds the Snakemake
-process that runs the script (:data:`SNAKEMAKE_MB`, measured 200 MB), and the request
-is :data:`SAFETY` times the sum, rounded up to 100 MB.
-
-How the run time was estimated
-------------------------------
-RK4 costs about the same per particle and step whatever the chain: at most
-:data:`SECONDS_PER_PARTICLE_STEP` on one core of this project's (shared, loaded) test
-machine. A job runs 2 B launches (collision and reference shots) of duration / dt steps
-each; dt is :func:`chain.physics.time_step.default_time_step` at the fastest launch
-unless the config sets it. The request is :data:`SAFETY` times that plus start-up, and
-never under :data:`MIN_RUNTIME_MIN` (queues round short jobs up anyway). Every paper
-job asks for the minimum; the estimate matters for long sweeps (N = 100, 5 ms,
-24 speeds: ~40 s of work).
+Run time: RK4 costs at most :data:`SECONDS_PER_PARTICLE_STEP` per particle and step on
+one core; a job runs 2 B launches of duration / dt steps. Every paper job asks for
+:data:`MIN_RUNTIME_MIN`; the estimate matters for long sweeps (N = 100, 5 ms, 24 speeds).
 """
 
 from __future__ import annotations
@@ -48,9 +24,9 @@ from chain.physics.time_step import default_time_step
 #: Resident memory of the simulate script before it allocates traces, MB: the numba
 #: compilation peak with an empty cache (measured 590 MB; 200 MB with a warm cache).
 BASE_MB = 600.0
-#: Bytes held per launch, recorded sample and bead (six float64, measured 47-48).
+#: Bytes held per launch and recorded sample: per bead (six float64, measured 47-48),
+#: and besides the beads (trace table rows).
 BYTES_PER_BEAD_SAMPLE = 48.0
-#: Bytes held per launch and recorded sample besides the beads (trace table rows).
 BYTES_PER_SAMPLE = 80.0
 #: Resident memory of the Snakemake process that runs the script inside the job, MB.
 SNAKEMAKE_MB = 200.0
@@ -58,16 +34,13 @@ SNAKEMAKE_MB = 200.0
 SAFETY = 1.5
 #: RK4 cost per particle and time step on one core, s (measured 2e-8 to 6e-8, loaded).
 SECONDS_PER_PARTICLE_STEP = 1e-7
-#: Python start-up, imports and file writing of one job, s.
+#: Python start-up, imports and file writing of one job, s; shortest request, minutes.
 STARTUP_S = 60.0
-#: Shortest run time asked for, minutes.
 MIN_RUNTIME_MIN = 10
-#: Estimated single-core integration a job needs before a second core pays, s. A
-#: thread parallelises only the integration; the job's 1-2 s of start-up and writing
-#: are serial, and a core held idle by a small job is a core another job cannot use
-#: (the paper run's jobs, ~2 s of estimate each, ran one at a time with 2 threads).
+#: Estimated single-core integration a job needs before a second core pays, s: only
+#: the integration runs in parallel, and a core held idle by a small job is a core
+#: another job cannot use. At most :data:`MAX_THREADS` threads.
 SECONDS_PER_THREAD = 10.0
-#: Most threads a job asks for (Snakemake gives no more than --cores anyway).
 MAX_THREADS = 8
 
 
@@ -96,22 +69,11 @@ def simulation_threads(
     duration: float,
     dt: float | None = None,
 ) -> int:
-    """Cores worth giving a simulate job: one per :data:`SECONDS_PER_THREAD` of
-    estimated integration, at least 1, at most the 2 ``n_launches`` launches (collision
-    and reference shots share one thread pool) and :data:`MAX_THREADS`.
-
-    The result does not depend on the thread count: launches are independent and
-    each runs on one thread (bit-identical to a serial run).
-
-    Parameters
-    ----------
-    model, n_launches, max_launch_speed, duration, dt
-        As in :func:`simulation_needs` (m/s, s).
-
-    Returns
-    -------
-    int
-        Threads (the paper's chains: 1; N = 100, 24 speeds, 5.2 ms: 4).
+    """Cores worth giving a simulate job (the paper's chains: 1; N = 100, 24 speeds,
+    5.2 ms: 4): one per :data:`SECONDS_PER_THREAD` of estimated integration, at least 1,
+    at most the 2 ``n_launches`` launches (collision and reference shots share one
+    thread pool) and :data:`MAX_THREADS`. Each launch runs on one thread: the results
+    do not depend on the count. Parameters as :func:`simulation_needs` (m/s, s).
     """
     n_launches = require_int("n_launches", n_launches, 1)
     duration = require_positive("duration", duration)
@@ -128,7 +90,8 @@ def simulation_needs(
     dt: float | None = None,
     threads: int = 1,
 ) -> JobNeeds:
-    """Memory and run time to ask for a simulate job (collision and reference batches).
+    """Memory (``mem_mb``, MB, a multiple of 100) and run time (``runtime``, minutes) to
+    ask for a simulate job (collision and reference batches).
 
     Parameters
     ----------
@@ -146,11 +109,6 @@ def simulation_needs(
         RK4 step, s; default :func:`chain.physics.time_step.default_time_step`.
     threads : int
         Cores the job gets (launches run in parallel threads).
-
-    Returns
-    -------
-    JobNeeds
-        ``mem_mb`` in MB (multiple of 100), ``runtime`` in minutes.
     """
     n_launches = require_int("n_launches", n_launches, 1)
     threads = require_int("threads", threads, 1)

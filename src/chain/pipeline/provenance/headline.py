@@ -1,10 +1,8 @@
 """Headline numbers of a run, compared with a committed reference (what CI checks).
 
-The headline numbers are read from a run's ``summary.json`` (results contract): the
-ballistic constants C_bal, the fitted C of Delta = C F_m^(-1/6) and the free exponent
-per source, model, N and estimator, the SSW slopes, and the largest energy drift of
-the conservative runs. A reference file holds the same numbers with the tolerance of
-each kind; it changes only in a reviewed commit that says why.
+From a run's ``summary.json``: C_bal, C and the free exponent per source, model, N and
+estimator, the SSW slopes, the largest energy drift of the conservative runs. The
+reference holds them with tolerances; it changes only in a reviewed commit saying why.
 """
 
 from __future__ import annotations
@@ -19,16 +17,12 @@ from chain.analysis.ssw_fits import SSW_FIT_COLUMNS
 from chain.analysis.ssw_speed import SPEED_COLUMNS
 from chain.analysis.ssw_track import TRACK_COLUMNS
 
-#: Files of the results contract (design.md), relative to results/<run_name>/.
-CONTRACT_FIGURES = (
-    "fig1_setup",
-    "fig3_simulation_traces",
-    "fig4_delay_vs_force",
-    "fig5_ssw_vs_force",
-    "ssw_spacetime",
+#: The results contract (design.md) in results/<run_name>/: the figures (Fig. 2 with an
+#: experiment), the contract columns of each table (more follow them), summary.json's keys.
+CONTRACT_FIGURES = tuple(
+    "fig1_setup fig3_simulation_traces fig4_delay_vs_force fig5_ssw_vs_force ssw_spacetime".split()
 )
 EXPERIMENT_FIGURES = ("fig2_experiment_traces",)
-#: Contract columns of each table (the tables have more after these).
 CONTRACT_TABLES = {
     "pulses.csv": (),
     "delays.csv": ("source", "model", "N", "F_m_N", "delay_us"),
@@ -38,22 +32,13 @@ CONTRACT_TABLES = {
     "ssw_track.csv": TRACK_COLUMNS[: TRACK_COLUMNS.index("separated") + 1],
     "ssw_speed.csv": SPEED_COLUMNS[: SPEED_COLUMNS.index("first_separated_contact") + 1],
 }
-SUMMARY_KEYS = (
-    "run_name",
-    "constants",
-    "paper",
-    "max_energy_drift",
-    "delay_fits",
-    "ssw_fits",
-    "ssw_resolved",
-    "ssw_separation",
-    "ssw_parity_ratio",
-    "ssw_far_field",
+SUMMARY_KEYS = tuple(
+    "run_name constants paper max_energy_drift delay_fits ssw_fits ssw_resolved "
+    "ssw_separation ssw_parity_ratio ssw_far_field".split()
 )
 
-#: Default tolerances, by kind of number and source. Simulations are deterministic
-#: but may differ in the last bits between CPUs (FMA, libm); the virtual experiment
-#: adds seeded noise on top, so its numbers are allowed more.
+#: Default tolerances, by kind of number and source: simulations may differ in the last
+#: bits between CPUs (FMA, libm); the virtual experiment adds seeded noise on top.
 DEFAULT_TOLERANCES = {
     "C_bal": {"relative": 1e-6},
     "C_us_N16/simulation": {"relative": 0.005},
@@ -67,23 +52,14 @@ DEFAULT_TOLERANCES = {
 
 
 def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = True) -> list[str]:
-    """Contract files absent from ``run_folder`` or lacking their columns / keys.
-
-    Parameters
-    ----------
-    run_folder : path
-        ``results/<run_name>``.
-    experiment : bool
-        Whether the run has an experiment side (then Fig. 2 is required too).
-    """
+    """Contract files absent from ``run_folder`` (``results/<run_name>``), empty, or
+    lacking their columns / keys; Fig. 2 too if the run has an ``experiment`` side."""
     import pandas as pd
 
     folder = Path(run_folder)
     problems = []
-    figures = CONTRACT_FIGURES + (EXPERIMENT_FIGURES if experiment else ())
-    for name in figures:
-        for suffix in (".pdf", ".png"):
-            path = folder / "figures" / f"{name}{suffix}"
+    for name in CONTRACT_FIGURES + (EXPERIMENT_FIGURES if experiment else ()):
+        for path in (folder / "figures" / f"{name}.pdf", folder / "figures" / f"{name}.png"):
             if not path.is_file() or path.stat().st_size == 0:
                 problems.append(f"{path}: missing or empty")
     for name, columns in CONTRACT_TABLES.items():
@@ -92,31 +68,22 @@ def missing_contract_files(run_folder: str | os.PathLike, experiment: bool = Tru
             problems.append(f"{path}: missing")
             continue
         header = list(pd.read_csv(path, nrows=0).columns)
-        absent = [c for c in columns if c not in header]
-        if absent:
+        if absent := [c for c in columns if c not in header]:
             problems.append(f"{path}: missing columns {absent}")
     for name in ("summary.json", "summary.md", "article.pdf"):
         if not (folder / name).is_file():
             problems.append(f"{folder / name}: missing")
-    if (folder / "summary.json").is_file():
-        summary = json.loads((folder / "summary.json").read_text())
-        absent = [k for k in SUMMARY_KEYS if k not in summary]
-        if absent:
-            problems.append(f"{folder / 'summary.json'}: missing keys {absent}")
+    if (path := folder / "summary.json").is_file():
+        summary = json.loads(path.read_text())
+        if absent := [k for k in SUMMARY_KEYS if k not in summary]:
+            problems.append(f"{path}: missing keys {absent}")
     return problems
 
 
 def headline_numbers(summary: dict) -> dict[str, float]:
-    """Flatten the headline numbers of a ``summary.json`` into {name: value}.
-
-    Names look like ``C_us_N16/simulation/elastic/N=25/fit_full`` so that a failing
-    check reads on its own.
-
-    Parameters
-    ----------
-    summary : dict
-        The parsed summary.json of a run.
-    """
+    """Flatten the headline numbers of ``summary`` (a run's parsed summary.json) into
+    {name: value}, names such as ``C_us_N16/simulation/elastic/N=25/fit_full`` (a
+    failing check reads on its own)."""
     numbers = {
         "C_bal/paper_form": summary["constants"]["C_bal_paper_us_N16"],
         "C_bal/exact_contact_time": summary["constants"]["C_bal_exact_us_N16"],
@@ -142,15 +109,9 @@ def tolerance_for(name: str, tolerances: dict) -> dict:
 
 
 def compare_with_reference(numbers: dict[str, float], reference: dict) -> list[str]:
-    """Headline numbers out of tolerance, missing or unexpected, one message each.
-
-    Parameters
-    ----------
-    numbers : dict
-        From :func:`headline_numbers`.
-    reference : dict
-        Parsed reference file: ``{"tolerances": {...}, "values": {name: value}}``.
-    """
+    """Headline ``numbers`` (:func:`headline_numbers`) out of tolerance, missing or
+    unexpected against ``reference`` (the parsed reference file: ``{"tolerances": {...},
+    "values": {name: value}}``), one message each."""
     tolerances = reference.get("tolerances", DEFAULT_TOLERANCES)
     expected = reference["values"]
     failures = []
@@ -186,15 +147,8 @@ def compare_with_reference(numbers: dict[str, float], reference: dict) -> list[s
 
 
 def reference_from_summary(summary: dict, note: str) -> dict:
-    """A reference file's content from a run's summary, with the default tolerances.
-
-    Parameters
-    ----------
-    summary : dict
-        Parsed summary.json.
-    note : str
-        Why the reference was (re)made; kept in the file.
-    """
+    """A reference file's content from a run's ``summary`` (parsed summary.json), with
+    the default tolerances and a ``note`` on why it was (re)made."""
     numbers = headline_numbers(summary)
     return {
         "about": (

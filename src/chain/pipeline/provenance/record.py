@@ -1,15 +1,9 @@
 """Which run produced an article: commit, commit date, config hash and package versions,
 and whether those versions are the lock's.
 
-Everything here is a function of the inputs, never of the clock, so the same checkout and
-configuration give the same article bytes: the date is the commit's (UTC), not today's.
-Outside a git checkout (a copied workflow, an unpacked archive) or without git, the
-commit and date say so; uncommitted changes are named as such, not hidden.
-
-The locks (``requirements/py3XX.lock``, one per Python, written by
-``requirements/lock.sh``) pin every package of the project and its extras; a run records
-every installed version and which of them differ from its Python's lock, so a number
-that moved can be traced to the release that moved it.
+Never the clock: the same checkout and config give the same article bytes (the date is
+the commit's). Every installed version is recorded, and which differ from the Python's
+lock (``requirements/py3XX.lock``): a number that moved can be traced to its release.
 """
 
 from __future__ import annotations
@@ -31,9 +25,8 @@ PACKAGES = ("hertzchain", "numpy", "scipy", "pandas", "numba", "matplotlib", "sn
 NOT_GIT = "not a git checkout"
 NOT_INSTALLED = "not installed"
 
-#: Folder of the locks in the checkout, one file per Python: py311.lock, py312.lock, ...
+#: Folder of the locks in the checkout (py311.lock, ...), and a pin: ``name==version``.
 LOCK_FOLDER = "requirements"
-#: A pin of a lock file: ``name==version`` at the start of a line.
 _PIN = re.compile(r"^([A-Za-z0-9][A-Za-z0-9._-]*)==([^\s;\\]+)", re.MULTILINE)
 
 
@@ -46,24 +39,19 @@ def config_hash(config: Mapping) -> str:
 
 def _git(directory: str | os.PathLike, *args: str) -> str | None:
     """Output of ``git -C directory args``, or None where git or the checkout is absent."""
+    command = ["git", "-C", os.fspath(directory), *args]
+    env = {**os.environ, "LC_ALL": "C", "TZ": "UTC"}
     try:
-        done = subprocess.run(
-            ["git", "-C", os.fspath(directory), *args],
-            capture_output=True,
-            text=True,
-            timeout=20,
-            check=False,
-            env={**os.environ, "LC_ALL": "C", "TZ": "UTC"},
-        )
+        done = subprocess.run(command, capture_output=True, text=True, timeout=20, env=env)
     except (OSError, subprocess.SubprocessError):
         return None
     return done.stdout.strip() if done.returncode == 0 else None
 
 
 def git_state(directory: str | os.PathLike) -> dict:
-    """``{"commit", "date", "dirty"}`` of the checkout holding ``directory``: commit
-    (12 hex digits), commit date (UTC, YYYY-MM-DD) and whether tracked files differ from
-    it; commit :data:`NOT_GIT` and date None outside a git checkout."""
+    """``{"commit", "date", "dirty"}`` of the checkout holding ``directory`` (a path):
+    commit (12 hex digits), commit date (UTC, YYYY-MM-DD) and whether tracked files
+    differ from it; commit :data:`NOT_GIT` and date None outside a git checkout."""
     inside = _git(directory, "rev-parse", "--is-inside-work-tree")
     commit = _git(directory, "rev-parse", "--short=12", "HEAD") if inside == "true" else None
     if not commit:
@@ -74,8 +62,8 @@ def git_state(directory: str | os.PathLike) -> dict:
 
 
 def package_versions(names: Iterable[str] = PACKAGES) -> dict[str, str]:
-    """Installed version of each distribution in ``names`` ('not installed' if absent),
-    and of Python."""
+    """Installed version of each distribution in ``names`` (distribution names; 'not
+    installed' if absent), and of Python."""
     versions = {"python": platform.python_version()}
     for name in names:
         try:
@@ -92,14 +80,12 @@ def normalized_name(name: str) -> str:
 
 
 def installed_distributions() -> dict[str, str]:
-    """Version of every distribution installed where this Python imports from,
-    by normalized name, sorted (the first found where one is installed twice, as
-    ``import`` finds it)."""
+    """Version of every distribution installed where this Python imports from, by
+    normalized name, sorted (the first found where one is installed twice, as ``import``
+    finds it)."""
     found: dict[str, str] = {}
     for distribution in metadata.distributions():
-        # Each .metadata parses the file anew: once per distribution, not twice (half
-        # of the ~0.13 s this took in every command's parse).
-        fields = distribution.metadata
+        fields = distribution.metadata  # parses the file: once per distribution
         name = fields["Name"]
         if name:  # a broken install has no name; it is no package of ours
             found.setdefault(normalized_name(name), fields["Version"])
@@ -114,7 +100,7 @@ def lock_path(directory: str | os.PathLike, python: tuple[int, int] | None = Non
 
 
 def read_lock(path: str | os.PathLike) -> dict[str, str]:
-    """The pins of a lock file: ``{normalized name: version}``."""
+    """The pins of the lock file ``path``: ``{normalized name: version}``."""
     text = Path(path).read_text(encoding="utf-8")
     return {normalized_name(name): version for name, version in _PIN.findall(text)}
 
@@ -122,32 +108,21 @@ def read_lock(path: str | os.PathLike) -> dict[str, str]:
 def compare_with_lock(
     directory: str | os.PathLike, installed: Mapping[str, str] | None = None
 ) -> dict:
-    """How the installed packages compare with the running Python's lock.
-
-    Returns ``{"file", "matches", "differ", "note"}``: the lock (relative to the
-    checkout), whether every locked package is installed at its locked version, and
-    ``{name: {"locked", "installed"}}`` for each one that is not (``installed`` is
-    'not installed' for an extra left out). Without a lock for this Python in the
-    checkout (an installed wheel, a copied workflow, an unlocked Python), ``file`` and
-    ``matches`` are None and ``note`` says so; nothing is compared.
-
-    Parameters
-    ----------
-    directory : path
-        Top folder of the checkout (the Snakefile's).
-    installed : mapping, optional
-        ``{normalized name: version}``; default :func:`installed_distributions`.
+    """How the ``installed`` packages (``{normalized name: version}``; default
+    :func:`installed_distributions`) compare with the running Python's lock in the
+    checkout whose top folder is ``directory``: ``{"file", "matches", "differ", "note"}``,
+    the lock (relative to the checkout), whether every locked package is installed at its
+    locked version, and ``{name: {"locked", "installed"}}`` for each one that is not.
+    Without a lock for this Python, ``file`` and ``matches`` are None and ``note`` says so.
     """
     path = lock_path(directory)
     relative = f"{LOCK_FOLDER}/{path.name}"
     if not path.is_file():
-        return {
-            "file": None,
-            "matches": None,
-            "differ": {},
-            "note": f"no {relative} for Python {platform.python_version()} in this copy "
-            "of the workflow (not a checkout, or an unlocked Python): versions not compared",
-        }
+        note = (
+            f"no {relative} for Python {platform.python_version()} in this copy of the "
+            "workflow (not a checkout, or an unlocked Python): versions not compared"
+        )
+        return {"file": None, "matches": None, "differ": {}, "note": note}
     installed = installed_distributions() if installed is None else installed
     differ = {
         name: {"locked": locked, "installed": installed.get(name, NOT_INSTALLED)}
@@ -159,15 +134,9 @@ def compare_with_lock(
 
 
 def lock_warnings(provenance: Mapping | None) -> list[str]:
-    """What a check says about a run's recorded versions against the lock: one line
-    naming every package that differs (locked and installed versions), a line when
-    nothing could be compared, nothing when the run was made as locked.
-
-    Parameters
-    ----------
-    provenance : mapping or None
-        The ``provenance`` block of a run's summary.json (:func:`run_provenance`).
-    """
+    """What a check says about the versions recorded in ``provenance`` (a run's
+    summary.json block, :func:`run_provenance`, or None) against the lock: a line naming
+    every package that differs, a line when nothing could be compared, or nothing."""
     lock = (provenance or {}).get("lock")
     if not lock:
         return ["summary.json records no comparison with the lock (an older run?)"]
@@ -187,18 +156,10 @@ def lock_warnings(provenance: Mapping | None) -> list[str]:
 
 
 def run_provenance(config: Mapping, directory: str | os.PathLike) -> dict:
-    """The provenance of a run (summary.json, and the article prints it): ``commit``,
+    """The provenance of a run of ``config`` (as Snakemake holds it, after overlays) from
+    the checkout holding ``directory``, for summary.json and the article: ``commit``,
     ``date``, ``dirty``, ``config_hash``, ``versions`` (Python and the main packages),
-    ``installed`` (every installed distribution) and ``lock`` (how they compare with the
-    lock: :func:`compare_with_lock`).
-
-    Parameters
-    ----------
-    config : mapping
-        The run's configuration as Snakemake holds it (after overlays).
-    directory : path
-        A directory of the workflow's checkout (the Snakefile's).
-    """
+    ``installed`` (every distribution) and ``lock`` (:func:`compare_with_lock`)."""
     installed = installed_distributions()
     return {
         **git_state(directory),
