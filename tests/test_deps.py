@@ -88,3 +88,13 @@ def test_a_damaged_store_is_an_empty_one(checkout, fresh_process, tmp_path, text
     fresh_process()
     deps.remember_imports(store)
     assert len(deps.script_sources(script, package)) == 3
+
+
+def test_a_local_helpers_own_imports_are_code_inputs_too(checkout, fresh_process, tmp_path):
+    """A script's local helper (``_logging.py`` beside it) and what the helper imports of
+    the package are both inputs: editing either reruns the script's jobs."""
+    script, package = checkout
+    (tmp_path / "_helper.py").write_text("from chain.c import h\n")
+    script.write_text("import _helper\nfrom chain.a import f\n")
+    files = deps.script_sources(script, package)
+    assert "_helper.py" in files and os.path.join("src", "chain", "c.py") in files

@@ -140,14 +140,15 @@ def _targets(root: Path, module: str, names: list[str]) -> list[Path]:
 
 def script_sources(script: str | os.PathLike, package_dir: str | os.PathLike) -> list[str]:
     """Source files ``script`` (``workflow/scripts/fig4_delay_vs_force.py``) runs besides
-    itself: its local helpers and the files it imports of ``package_dir`` (``src/chain``),
-    transitively; sorted, relative to the current directory (a moved or copied checkout
-    names the same inputs)."""
+    itself: its local helpers and the files it and they import of ``package_dir``
+    (``src/chain``), transitively; sorted, relative to the current directory (a moved or
+    copied checkout names the same inputs)."""
     script, root = Path(script).resolve(), Path(package_dir).resolve()
     files = {f for m, _ in _imported_names(script) if (f := script.parent / f"{m}.py").is_file()}
-    for module, names in _imported_names(script):
-        for target in _targets(root, module, names):
-            files |= _package_closure(root, target)
+    for source in [script, *files]:
+        for module, names in _imported_names(source):
+            for target in _targets(root, module, names):
+                files |= _package_closure(root, target)
     here = Path.cwd().resolve()
     return sorted(os.path.relpath(path, here) for path in files)
 
