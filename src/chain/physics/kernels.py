@@ -182,13 +182,6 @@ def _plain_step(
     return increment, end, varied
 
 
-# A refined step is EVENT_SUBSTEPS plain steps of dt / EVENT_SUBSTEPS through the same
-# code, which numba compiled once more (and in a function of its own) before: one copy
-# fewer of the step to compile, the same speed. The step is inlined at two call sites,
-# one per order of the arrays, so that the loop never swaps array variables: a swap
-# costs reference-count updates. Bits unchanged.
-
-
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
     """RK4 for one launch of the whole chain; ``u`` and ``v`` end as the final state.
     Returns the status, the step at which it was set, and the number of steps refined
@@ -244,6 +237,11 @@ def _work_buffers(n):
     )  # fmt: skip
 
 
+# A refined step is EVENT_SUBSTEPS plain steps of dt / EVENT_SUBSTEPS through the same
+# inlined step, at two call sites, one per order of the arrays, so that the loop never
+# swaps array variables (a swap costs reference-count updates). One function, 62 lines:
+# split into named steps it gives the same bits but compiles ~1.8 s longer per kind of
+# model and runs ~2.5 % slower with Kuwabara-Kono (benchmarks/kernel_breakdown.py --split).
 @compile_once.shared
 @numba.njit(cache=CACHE, nogil=True)
 def _integrate_part(
