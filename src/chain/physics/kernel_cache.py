@@ -2,15 +2,12 @@
 
 numba keys a cached kernel on its own file (time stamp and size) and its own function's
 bytecode: what the kernel inlines from another file, and the constants it reads from
-one, are not part of the key. A kernel of :mod:`chain.physics.kernels`, which inlines
-the right-hand side of :mod:`chain.physics.slopes`, was loaded from the cache unchanged
-after slopes.py was edited (checked on 27 Nov 2026: a doubled Hertz force there left
-the recorded forces as they were until the cache was emptied), and
-:mod:`chain.physics.reference_kernel` reads kernels.py's constants.
-:func:`forget_if_sources_changed` keeps a digest of the sources in each kernel's cache
-folder and removes the kernels' cache indexes when it changes, so that numba compiles
-them again. The digest covers every source of the physics kernels: an edit to any of
-them recompiles them all (seconds), never a stale one.
+one, are not part of the key. So a kernel of :mod:`chain.physics.kernels` would be
+loaded unchanged after an edit of :mod:`chain.physics.slopes`, whose right-hand side it
+inlines. :func:`forget_if_sources_changed` keeps a digest of the sources in each
+kernel's cache folder and removes the kernels' cache indexes when it changes, so that
+numba compiles them again. The digest covers every source of the physics kernels: an
+edit to any of them recompiles them all (seconds), never a stale one.
 """
 
 from __future__ import annotations
