@@ -36,18 +36,10 @@ from chain.atomic import write_csv_atomic
 from chain.errors import bead_number_problem
 from chain.sampling import TIME_STEP_TOLERANCE
 
+#: Columns that name one shot, first in every table with a row per shot.
+SHOT_COLUMNS = ("source", "model", "N", "shot", "kind", "amplitude")
 #: Columns every trace table has, in order, before the sensor columns.
-META_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "v0_left_m_s",
-    "v0_right_m_s",
-    "t_s",
-)
+META_COLUMNS = (*SHOT_COLUMNS, "v0_left_m_s", "v0_right_m_s", "t_s")
 SOURCES = ("simulation", "experiment", "lammps")
 KINDS = ("collision", "reference")
 _SENSOR_COLUMN = re.compile(r"^force_bead(\d+)_N$")

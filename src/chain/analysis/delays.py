@@ -27,40 +27,15 @@ from chain.analysis.selection import GROUP as _GROUP
 from chain.analysis.selection import apply_selection
 
 #: Columns of :func:`delay_table`, in order (the last three are extras).
-DELAY_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "amplitude",
-    "wave",
-    "estimator",
-    "F_m_N",
-    "delay_us",
-    "tof_crossed_us",
-    "tof_reference_us",
-    "n_reference",
-    "ok",
-    "reason",
-    "F_m_stderr_N",
-    "delay_stderr_us",
-    "F_crossed_N",
+DELAY_COLUMNS = tuple(
+    "source model N shot amplitude wave estimator F_m_N delay_us tof_crossed_us "
+    "tof_reference_us n_reference ok reason F_m_stderr_N delay_stderr_us F_crossed_N".split()
 )
 
 #: Columns of :func:`delay_fit_table`, in order (after ``n_points``: extras).
-DELAY_FIT_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "estimator",
-    "C_us_N16",
-    "C_stderr_us_N16",
-    "exponent",
-    "exponent_stderr",
-    "n_points",
-    "prefactor_free_us",
-    "prefactor_free_stderr_us",
-    "rms_residual_us",
+DELAY_FIT_COLUMNS = tuple(
+    "source model N estimator C_us_N16 C_stderr_us_N16 exponent exponent_stderr n_points "
+    "prefactor_free_us prefactor_free_stderr_us rms_residual_us".split()
 )
 
 #: (first sensor met, sensor where the crossed wave is read) per wave.

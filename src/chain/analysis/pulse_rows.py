@@ -26,32 +26,12 @@ from chain.analysis.pulses import (
     measure_pulse,
 )
 from chain.errors import ParameterError
-from chain.traces import iter_shots, sensor_beads
+from chain.traces import SHOT_COLUMNS, iter_shots, sensor_beads
 
 #: Columns of :func:`pulse_table`, in order.
-PULSE_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "sensor",
-    "bead",
-    "role",
-    "wave",
-    "estimator",
-    "F_m_N",
-    "T_s",
-    "tau_s",
-    "F_m_stderr_N",
-    "T_stderr_s",
-    "tau_stderr_s",
-    "ok",
-    "reason",
-    "baseline_N",
-    "noise_N",
-    "n_samples",
+PULSE_COLUMNS = SHOT_COLUMNS + tuple(
+    "sensor bead role wave estimator F_m_N T_s tau_s F_m_stderr_N T_stderr_s tau_stderr_s "
+    "ok reason baseline_N noise_N n_samples".split()
 )
 
 
@@ -82,19 +62,13 @@ def pulse_table(
     Returns
     -------
     DataFrame
-        ``source, model, N, shot, kind, amplitude, sensor, bead, role, wave, estimator,
-        F_m_N, T_s, tau_s, F_m_stderr_N, T_stderr_s, tau_stderr_s, ok, reason``, then
-        ``baseline_N, noise_N, n_samples``.
+        Columns :data:`PULSE_COLUMNS`.
     """
     estimators = tuple(estimators)
     unknown = [e for e in estimators if e not in ESTIMATORS]
     if unknown:
         raise ParameterError(f"unknown estimators {unknown}; choose from {ESTIMATORS}")
-    thresholds = {
-        "rel_prominence": rel_prominence,
-        "min_snr": min_snr,
-        "min_height_N": min_height_N,
-    }
+    thresholds = dict(rel_prominence=rel_prominence, min_snr=min_snr, min_height_N=min_height_N)
     beads = sensor_beads(traces)
     sensors = [("S1", beads[0])] + ([("S2", beads[-1])] if len(beads) > 1 else [])
     rows = []

@@ -120,21 +120,7 @@ def fit_fixed_exponent(
         return CoefficientFit(math.nan, math.nan, float(exponent), n, math.nan)
     if np.any(x <= 0):
         raise ParameterError("x must be > 0 for a power law")
-    basis = x**exponent
-    normal = float(np.sum(weight * basis**2))
-    coefficient = float(np.sum(weight * basis * y)) / normal
-    residual = y - coefficient * basis
-    if sigma is not None and absolute_sigma:
-        variance = 1.0 / normal
-    else:
-        variance = float(np.sum(weight * residual**2)) / (n - 1) / normal
-    return CoefficientFit(
-        coefficient,
-        math.sqrt(variance),
-        float(exponent),
-        n,
-        float(np.sqrt(np.mean(residual**2))),
-    )
+    return _coefficient_fit(x**exponent, y, weight, exponent, sigma is not None and absolute_sigma)
 
 
 def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> CoefficientFit:
@@ -153,14 +139,21 @@ def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> Coeff
     n = x.size
     if n < MIN_POINTS_ONE_PARAMETER:
         return CoefficientFit(math.nan, math.nan, 1.0, n, math.nan)
-    normal = float(np.sum(weight * x**2))
-    slope = float(np.sum(weight * x * y)) / normal
-    residual = y - slope * x
-    if sigma is not None and absolute_sigma:
+    return _coefficient_fit(x, y, weight, 1.0, sigma is not None and absolute_sigma)
+
+
+def _coefficient_fit(basis, y, weight, exponent: float, absolute: bool) -> CoefficientFit:
+    """The weighted least-squares C of y = C basis, its error (from the weights alone
+    when ``absolute``, else scaled by the reduced chi-square: module docstring)."""
+    normal = float(np.sum(weight * basis**2))
+    coefficient = float(np.sum(weight * basis * y)) / normal
+    residual = y - coefficient * basis
+    if absolute:
         variance = 1.0 / normal
     else:
-        variance = float(np.sum(weight * residual**2)) / (n - 1) / normal
-    return CoefficientFit(slope, math.sqrt(variance), 1.0, n, float(np.sqrt(np.mean(residual**2))))
+        variance = float(np.sum(weight * residual**2)) / (basis.size - 1) / normal
+    rms = float(np.sqrt(np.mean(residual**2)))
+    return CoefficientFit(coefficient, math.sqrt(variance), float(exponent), basis.size, rms)
 
 
 def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:

@@ -14,17 +14,8 @@ from chain.analysis.regression import fit_proportional, ratio_with_error
 from chain.analysis.rows import is_ok
 
 #: Columns of :func:`ssw_fit_table`.
-SSW_FIT_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "slope",
-    "slope_stderr",
-    "slope_stat",
-    "slope_sys",
-    "n_points",
-    "n_resolved",
-    "method",
+SSW_FIT_COLUMNS = tuple(
+    "source model N slope slope_stderr slope_stat slope_sys n_points n_resolved method".split()
 )
 
 

@@ -64,26 +64,10 @@ MIN_RUN = 3
 #: Fewest separated contacts for a speed fit (two intervals).
 MIN_SPEED_CONTACTS = 3
 
-WAVES = ("LSTW", "RSTW")
-
 #: Columns of :func:`ssw_track_table` (after ``separated``: extras).
-TRACK_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "wave",
-    "contact",
-    "time_us",
-    "force_N",
-    "F_m_N",
-    "separated",
-    "detached",
-    "trailing_min_N",
-    "distance_beads",
-    "main_time_us",
-    "main_force_N",
-    "other_time_us",
+TRACK_COLUMNS = tuple(
+    "source model N shot wave contact time_us force_N F_m_N separated detached "
+    "trailing_min_N distance_beads main_time_us main_force_N other_time_us".split()
 )
 
 
@@ -189,9 +173,8 @@ def _first_bump(signal, main_index: int, window_s: float, floor_N: float, time) 
     ``floor_N``) within ``window_s`` of it, or -1.
 
     The first peak ``scipy.signal.find_peaks(signal[main_index:], height=floor_N,
-    prominence=floor_N)`` returns, found without scipy.signal, whose import (1.1 s with
-    scipy 1.17, which parses every function's docstring and loads scipy.stats) was
-    most of an ssw_track job's start-up; ``tests/test_ssw_track.py`` compares the two."""
+    prominence=floor_N)`` returns, found without importing scipy.signal (a second, most
+    of an ssw_track job's start-up); ``tests/test_ssw_track.py`` compares the two."""
     if not np.isfinite(window_s):
         return -1
     segment = np.asarray(signal[main_index:], dtype=float)
