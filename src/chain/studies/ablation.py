@@ -6,13 +6,12 @@ bead, split sensor beads instead of a point readout, Kuwabara-Kono dissipation, 
 and a digitiser, shot-to-shot speed mismatch and launch jitter, the 5 % acceptance
 protocol and its own range of amplitudes. A variant changes some of them
 (:mod:`chain.pipeline.config.ablation` maps the config's ``ablation.variants`` to the
-settings of each chain). :func:`run_variant` runs the virtual experiment of every
+settings of each chain). :func:`run_variant_shots` runs the virtual experiment of every
 chain with those settings (the same seed as the run, so a variant with no overrides
-reproduces the run's experiment) and fits Delta = C F_m^(-1/6) and a free power law
-as every series is fitted (:mod:`chain.analysis.recipe`); replicates repeat it with other seeds
-to show the spread a seed gives (:mod:`chain.studies.ablation_table`).
-
-This module reads no config and knows no Snakemake.
+reproduces the run's experiment) and :func:`variant_fits` fits Delta = C F_m^(-1/6) and
+a free power law as every series is fitted (:mod:`chain.analysis.recipe`); replicates
+repeat it with other seeds to show the spread a seed gives
+(:mod:`chain.studies.ablation_table`).
 """
 
 from __future__ import annotations
@@ -34,15 +33,21 @@ from chain.labels import VIRTUAL_SERIES
 from chain.studies.mechanism_fits import variant_ssw_fits
 
 
-def run_variant(
+def run_variant_shots(
     settings_per_chain: Sequence[Mapping],
     tolerance: float | None,
     estimators: Sequence[str] = ("fit_full",),
     series: str = VIRTUAL_SERIES,
-) -> pd.DataFrame:
-    """Run the virtual experiment on each chain, analyse it as the pipeline does, and
-    fit |Delta| against F_m (:func:`run_variant_shots`, then
-    :func:`chain.analysis.recipe.fit_pulses`).
+    datasets: Sequence[str | os.PathLike] | None = None,
+) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
+    """Run the virtual experiment on each chain and fit its pulses and select its shots
+    as the pipeline does.
+
+    The shots go through the measured-data path: written in the measured-trace format
+    to a temporary folder, then analysed by :func:`analyse_datasets`. With
+    ``datasets`` (one folder per chain, written by the virtual experiment with exactly
+    ``settings_per_chain`` and ``series``: the run's own), those are analysed instead
+    of simulating the same shots again.
 
     Parameters
     ----------
@@ -55,32 +60,8 @@ def run_variant(
         Pulse estimators (:data:`chain.analysis.pulses.ESTIMATORS`).
     series : str
         Series name (the ``model`` column).
-
-    Returns
-    -------
-    DataFrame
-        :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
-    """
-    _, pulses, selection = run_variant_shots(settings_per_chain, tolerance, estimators, series)
-    return fit_pulses(pulses, selection)
-
-
-def run_variant_shots(
-    settings_per_chain: Sequence[Mapping],
-    tolerance: float | None,
-    estimators: Sequence[str] = ("fit_full",),
-    series: str = VIRTUAL_SERIES,
-    datasets: Sequence[str | os.PathLike] | None = None,
-) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
-    """Run the virtual experiment on each chain and fit its pulses and select its shots
-    as the pipeline does (parameters as :func:`run_variant`).
-
-    The shots go through the measured-data path: written in the measured-trace format
-    to a temporary folder, then analysed by :func:`analyse_datasets`. With
-    ``datasets`` (one folder per chain, written by the virtual experiment with exactly
-    ``settings_per_chain`` and ``series``: the run's own, see
-    :meth:`chain.pipeline.plan.run_plan.RunPlan.ablation_datasets`), those are analysed instead
-    of simulating the same shots again.
+    datasets : sequence of path, optional
+        The chains' dataset folders, already written.
 
     Returns
     -------
@@ -110,7 +91,7 @@ def analyse_datasets(
     datasets : sequence of path
         Dataset folders in the measured-trace format, one per chain.
     tolerance, estimators, series
-        As :func:`run_variant`.
+        As :func:`run_variant_shots`.
 
     Returns
     -------

@@ -21,20 +21,9 @@ from chain.studies.mechanism_fits import analyse_traces
 from chain.studies.mechanism_settings import granular_chain
 
 #: Columns of ``tables/lammps_check.csv``.
-CHECK_COLUMNS = (
-    "N",
-    "model",
-    "eta_s",
-    "n_speeds",
-    "C_kernel",
-    "C_kernel_stderr",
-    "C_lammps",
-    "rel_diff_C",
-    "max_trace_diff_over_Fm",
-    "max_trace_diff_N",
-    "dt_kernel_s",
-    "dt_lammps_s",
-    "within_tolerance",
+CHECK_COLUMNS = tuple(
+    "N model eta_s n_speeds C_kernel C_kernel_stderr C_lammps rel_diff_C "
+    "max_trace_diff_over_Fm max_trace_diff_N dt_kernel_s dt_lammps_s within_tolerance".split()
 )
 
 #: The cross-check's targets: C within this relative difference, and every sensor

@@ -14,19 +14,9 @@ from collections.abc import Mapping
 import pandas as pd
 
 #: Columns of ``tables/sweep.csv``, in order.
-SWEEP_COLUMNS = (
-    "model",
-    "eta_s",
-    "N",
-    "parity",
-    "C_us_N16",
-    "C_stderr_us_N16",
-    "exponent",
-    "exponent_stderr",
-    "n_delays",
-    "ssw_slope",
-    "ssw_slope_stderr",
-    "n_ssw",
+SWEEP_COLUMNS = tuple(
+    "model eta_s N parity C_us_N16 C_stderr_us_N16 exponent exponent_stderr n_delays "
+    "ssw_slope ssw_slope_stderr n_ssw".split()
 )
 #: The SSW measurement taken from ``ssw_fits.csv`` when it holds several.
 SSW_METHOD = "residual"
