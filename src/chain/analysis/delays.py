@@ -162,7 +162,8 @@ def _why(pulse) -> str:
 
 
 def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
-    """Fits of |Delta| against F_m (the rows of ``delay_fits.csv``).
+    """Fits of |Delta| against F_m (the rows of ``delay_fits.csv``, columns
+    :data:`DELAY_FIT_COLUMNS`).
 
     Per (source, model, N, estimator), and pooled over N (``N = "pooled"``) per
     (source, model, estimator), from the ``ok`` rows of both waves:
@@ -181,11 +182,6 @@ def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
     ----------
     delays : DataFrame
         ``delays.csv`` rows (:func:`delay_table`).
-
-    Returns
-    -------
-    DataFrame
-        Columns :data:`DELAY_FIT_COLUMNS`.
     """
     rows = []
     groups = [(keys, group) for keys, group in delays.groupby([*_GROUP, "estimator"], sort=True)]

@@ -43,7 +43,8 @@ def pulse_table(
     min_snr: float = DEFAULT_MIN_SNR,
     min_height_N: float = 0.0,
 ) -> pd.DataFrame:
-    """The rows of ``pulses.csv``: every main pulse of every shot, per estimator.
+    """The rows of ``pulses.csv`` (:data:`PULSE_COLUMNS`): every main pulse of every
+    shot, per estimator.
 
     Roles as in the module docstring. A pulse that is not detected gives rows with
     ``ok`` False and reason "no pulse detected"; when a collision signal shows one
@@ -58,11 +59,6 @@ def pulse_table(
     rel_prominence, min_snr, min_height_N
         Detection thresholds, as in :func:`chain.analysis.pulses.find_pulses`
         (fractions, noise standard deviations, N).
-
-    Returns
-    -------
-    DataFrame
-        Columns :data:`PULSE_COLUMNS`.
     """
     estimators = tuple(estimators)
     unknown = [e for e in estimators if e not in ESTIMATORS]

@@ -188,7 +188,8 @@ def find_pulses(
     min_snr: float = DEFAULT_MIN_SNR,
     min_height_N: float = 0.0,
 ) -> list[PulseSegment]:
-    """The main pulses of a signal, in time order, as index ranges.
+    """The main pulses of a signal, in time order, as index ranges (empty when no pulse
+    clears the thresholds).
 
     Peaks are found with :func:`scipy.signal.find_peaks`; a main pulse has a prominence
     of at least ``rel_prominence`` times the largest excursion and a height above
@@ -214,11 +215,6 @@ def find_pulses(
         Least height of a pulse above the baseline, in noise standard deviations.
     min_height_N : float
         Least height above the baseline, N.
-
-    Returns
-    -------
-    list of PulseSegment
-        Empty when no pulse clears the thresholds.
     """
     time, force = _as_signal(time_s, force_N)
     baseline_N, noise_N = _baseline(time, force, baseline_N, noise_N)
@@ -265,7 +261,8 @@ def fit_pulse(
     baseline_N: float | None = None,
     noise_N: float | None = None,
 ) -> PulseFit:
-    """Amplitude, arrival time and width of the largest pulse of a signal.
+    """Amplitude, arrival time and width of the largest pulse of a signal, ``ok=False``
+    with a reason when it cannot be measured.
 
     Pass one segment of :func:`find_pulses` (``time_s[seg.slice]``...) to measure a
     pulse that has neighbours, with the baseline of the whole signal.
@@ -281,11 +278,6 @@ def fit_pulse(
     baseline_N, noise_N : float, optional
         Baseline offset and noise standard deviation, N; estimated from the signal by
         :func:`estimate_baseline` when not given.
-
-    Returns
-    -------
-    PulseFit
-        ``ok=False`` with a reason when the pulse cannot be measured.
     """
     if estimator not in ESTIMATORS:
         raise ParameterError(f"estimator must be one of {ESTIMATORS}, got {estimator!r}")

@@ -93,7 +93,8 @@ class PowerLawFit:
 def fit_fixed_exponent(
     x, y, exponent: float = -1.0 / 6.0, sigma=None, *, absolute_sigma: bool = False
 ) -> CoefficientFit:
-    """Least-squares C of y = C x^exponent with its standard error.
+    """Least-squares C of y = C x^exponent with its standard error (NaN with fewer
+    than 2 points).
 
     Parameters
     ----------
@@ -108,11 +109,6 @@ def fit_fixed_exponent(
     absolute_sigma : bool
         Take ``sigma`` as absolute (True) or only relative (False, the error is then
         scaled by the reduced chi-square).
-
-    Returns
-    -------
-    CoefficientFit
-        NaN coefficient and error with fewer than 2 points.
     """
     x, y, weight = _points(x, y, sigma)
     n = x.size
@@ -157,7 +153,8 @@ def _coefficient_fit(basis, y, weight, exponent: float, absolute: bool) -> Coeff
 
 
 def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
-    """Least-squares y = A x^p with A and p free, and their standard errors.
+    """Least-squares y = A x^p with A and p free, and their standard errors (NaN with
+    fewer than 3 points).
 
     Parameters
     ----------
@@ -167,11 +164,6 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
         Standard errors of y; None for unweighted least squares.
     method : {"loglog", "nonlinear"}
         Straight line in ln y vs ln x, or nonlinear fit of y (module docstring).
-
-    Returns
-    -------
-    PowerLawFit
-        NaN values with fewer than 3 points.
     """
     if method not in POWER_LAW_METHODS:
         raise ParameterError(f"method must be one of {POWER_LAW_METHODS}, got {method!r}")

@@ -105,7 +105,8 @@ def flag_unusable(
 
 
 def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict:
-    """Rows and flagged rows of a results table, per source.
+    """Rows and flagged rows of a results table, per source: ``{source: {"rows": n,
+    "flagged": n_ok_false, "nan": n_ok_but_nan}}``.
 
     Parameters
     ----------
@@ -113,11 +114,6 @@ def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict
         A table with ``source`` and ``ok`` columns.
     columns : iterable of str
         Value columns: an ``ok`` row with a NaN there counts as ``nan``.
-
-    Returns
-    -------
-    dict
-        ``{source: {"rows": n, "flagged": n_ok_false, "nan": n_ok_but_nan}}``.
     """
     if table is None or not len(table):
         return {}
@@ -145,8 +141,9 @@ def of_estimator(table: pd.DataFrame, estimator: str) -> pd.DataFrame:
 
 
 def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
-    """The rows of ``table`` whose ``column`` is ``value``, without that column: the
-    table a study tagged per estimator would have written for that one alone.
+    """The rows of ``table`` whose ``column`` is ``value``, in their order, indexed
+    0..n-1, without that column: the table a study tagged per estimator would have
+    written for that one alone.
 
     Parameters
     ----------
@@ -156,11 +153,6 @@ def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
         The tag column (e.g. ``estimator``, ``main_estimator``).
     value : str
         The tag of the rows kept.
-
-    Returns
-    -------
-    DataFrame
-        Those rows in their order, indexed 0..n-1, ``column`` dropped.
     """
     return _tagged(table, column, value).drop(columns=column)
 

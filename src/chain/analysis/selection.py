@@ -226,17 +226,13 @@ def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.D
 
 
 def selection_counts(selection: pd.DataFrame | None) -> list[dict]:
-    """Kept and rejected shots of the acceptance protocol per series, chain and kind.
+    """Kept and rejected shots of the acceptance protocol per series, chain and kind:
+    ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
 
     Parameters
     ----------
     selection : DataFrame or None
         ``experiment/selection.csv`` (:func:`chain.analysis.selection.select_shots`).
-
-    Returns
-    -------
-    list of dict
-        ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
     """
     if selection is None or not len(selection):
         return []

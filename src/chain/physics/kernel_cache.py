@@ -34,7 +34,8 @@ def sources_digest(sources: Iterable[str | os.PathLike]) -> str:
 def forget_if_sources_changed(module: str, namespace: dict, sources: Iterable | None = None):
     """Remove the cache indexes of the numba kernels that ``module`` defines when
     ``sources`` changed since the digest kept beside them; then keep the new digest.
-    Call it at the end of the module, before any of its kernels runs.
+    Call it at the end of the module, before any of its kernels runs. Returns whether
+    indexes were removed (the sources changed, or no digest was kept).
 
     Parameters
     ----------
@@ -47,11 +48,6 @@ def forget_if_sources_changed(module: str, namespace: dict, sources: Iterable | 
         written, is left alone (numba then compiles it in every process anyway).
     sources : iterable of paths, optional
         The files they are compiled from; by default :data:`SOURCES` beside this module.
-
-    Returns
-    -------
-    bool
-        Whether indexes were removed (the sources changed, or no digest was kept).
     """
     here = Path(__file__).parent
     files = [here / s for s in SOURCES] if sources is None else list(sources)

@@ -41,7 +41,7 @@ def run_variant_shots(
     datasets: Sequence[str | os.PathLike] | None = None,
 ) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
     """Run the virtual experiment on each chain and fit its pulses and select its shots
-    as the pipeline does.
+    as the pipeline does; returns what :func:`analyse_datasets` does.
 
     The shots go through the measured-data path: written in the measured-trace format
     to a temporary folder, then analysed by :func:`analyse_datasets`. With
@@ -62,10 +62,6 @@ def run_variant_shots(
         Series name (the ``model`` column).
     datasets : sequence of path, optional
         The chains' dataset folders, already written.
-
-    Returns
-    -------
-    As :func:`analyse_datasets`.
     """
     if datasets:
         return analyse_datasets(datasets, tolerance, estimators, series)
