@@ -10,7 +10,6 @@ writes ``summary.json`` atomically; :mod:`chain.report.text.markdown` writes the
 from __future__ import annotations
 
 import json
-import logging
 import math
 import os
 from collections.abc import Iterable, Mapping
@@ -37,8 +36,6 @@ from chain.report.numbers.paper import PAPER, PAPER_BEADS
 
 #: Significant digits of floats in summary.json.
 JSON_DIGITS = 10
-
-log = logging.getLogger(__name__)
 
 
 def _number(value):
@@ -224,16 +221,8 @@ def decisions(summary: Mapping) -> dict:
 def ssw_summary(
     ssw: pd.DataFrame | None, ssw_fits: pd.DataFrame, ssw_speed: pd.DataFrame | None
 ) -> dict:
-    """The SSW keys of ``summary.json``.
-
-    Parameters
-    ----------
-    ssw : DataFrame or None
-        ``ssw.csv``.
-    ssw_fits : DataFrame
-        ``ssw_fits.csv``.
-    ssw_speed : DataFrame or None
-        ``ssw_speed.csv``.
+    """The SSW keys of ``summary.json`` from ``ssw.csv``, ``ssw_fits.csv`` and
+    ``ssw_speed.csv`` (``ssw`` and ``ssw_speed`` None when the run has none).
 
     Returns
     -------
@@ -322,15 +311,7 @@ def _residual_rows(ssw: pd.DataFrame | None) -> pd.DataFrame | None:
 
 
 def write_summary_json(summary: Mapping, json_path: str | os.PathLike) -> None:
-    """Write ``summary.json`` atomically (temporary name, then rename), sorted keys and
-    floats to :data:`JSON_DIGITS` digits; ``summary.md`` is written from it by
-    :func:`chain.report.text.markdown.write_summary_markdown`.
-
-    Parameters
-    ----------
-    summary : mapping
-        The dict of :func:`build_summary`.
-    json_path : path
-        Destination.
-    """
+    """Write ``summary`` (:func:`build_summary`) to ``json_path`` atomically, as
+    :func:`summary_json`; ``summary.md`` is written from it by
+    :func:`chain.report.text.markdown.write_summary_markdown`."""
     write_text_atomic(summary_json(summary), json_path)
