@@ -32,8 +32,8 @@ CHAIN_STREAM = 24
 #: Fields drawn once per chain (non-negative).
 _CHAIN_FIELDS = ("radius_dispersion", "gap_mean_m", "gap_spread_m")
 
-#: Field names of datasets written before the fields took the config's names (issue
-#: 31) -> today's names, so that :meth:`VirtualExperiment.from_dataset` reads them.
+#: Field names of older datasets -> the config's names, for
+#: :meth:`VirtualExperiment.from_dataset`.
 _LEGACY_FIELDS = {
     "eta": "eta_s",
     "drag_rate": "drag_rate_per_s",
@@ -118,10 +118,9 @@ class VirtualExperiment:
         Relative standard deviation of the reference shots' striker speed; None: the
         same as ``speed_mismatch``. The random draws are the same whatever the value.
     radius_dispersion : float
-        Relative standard deviation of the bead radii (dimensionless; 0: equal beads).
-        Each bead's radius is R (1 + s e), e standard normal, its mass and its contacts'
-        stiffness follow; drawn once per chain (one set of beads for every shot), from
-        ``default_rng((seed, CHAIN_STREAM))``, so the shot draws are unchanged.
+        Relative standard deviation s of the bead radii (0: equal beads): each radius
+        is R (1 + s e), e standard normal, drawn once per chain (one set of beads for
+        every shot) from ``default_rng((seed, CHAIN_STREAM))``, apart from the shots'.
     gap_mean_m, gap_spread_m : float
         Mean and standard deviation of the gap between neighbouring beads at rest, m
         (0: barely touching); gap k = max(0, mean + spread e), once per chain as above.
@@ -164,8 +163,7 @@ class VirtualExperiment:
     right_delay_s: float = 0.0
 
     def __post_init__(self) -> None:
-        # Checked in field order; lists from a config become tuples (the dataclass is
-        # frozen, hence object.__setattr__).
+        # Checked in field order; lists from a config become tuples.
         require_int("n_beads", self.n_beads, 2)
         beads = check_bead_numbers("sensor_beads", self.sensor_beads, self.n_beads)
         object.__setattr__(self, "sensor_beads", beads)

@@ -126,15 +126,14 @@ def build_summary(
     Returns
     -------
     dict
-        ``run_name``, ``material``, ``radius_m``, ``main_estimator``,
-        ``conservative_models``, ``constants``,
-        ``paper``, ``max_energy_drift`` (largest relative drift of the conservative
-        runs, None without any), ``energy_drift_by_model``, ``delay_fits`` and
-        ``ssw_fits`` (the rows of the tables), ``flagged`` (per table and source:
-        ``rows``, ``flagged`` = ok False, ``nan`` = ok but a NaN value; ssw counts the
-        ``residual`` rows, the ones fitted and drawn), ``selection`` (kept/rejected
-        shots per series, N and kind), ``experiment_tolerance``, and the SSW keys of
-        :func:`ssw_summary`.
+        The arguments' plain values, ``constants``, ``paper``, ``max_energy_drift``
+        (largest relative drift of the conservative runs, None without any),
+        ``energy_drift_by_model``, ``delay_fits`` and ``ssw_fits`` (the rows of the
+        tables), ``flagged`` (per table and source: ``rows``, ``flagged`` = ok False,
+        ``nan`` = ok but a NaN value; ssw counts the ``residual`` rows, the ones
+        fitted and drawn), ``selection`` (kept/rejected shots per series, N and kind),
+        ``experiment_tolerance``, ``attenuation``, the SSW keys of :func:`ssw_summary`
+        and :func:`decisions`.
     """
     conservative = set(conservative_models)
     drift_by_model = {}
