@@ -230,10 +230,7 @@ def find_pulses(
     # belong to one pulse, and pulses that close could not be told apart anyway.
     fwhm = _half_width_samples(signal, int(np.argmax(signal)))
     peaks, properties = find_peaks(
-        signal,
-        height=threshold,
-        prominence=rel_prominence * largest,
-        distance=max(1.0, fwhm),
+        signal, height=threshold, prominence=rel_prominence * largest, distance=max(1.0, fwhm)
     )
     if peaks.size == 0:
         return []

@@ -258,13 +258,7 @@ def track_collision(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> d
 
 
 def ssw_track_table(
-    time_s,
-    contact_force_N,
-    *,
-    source: str,
-    model: str,
-    shots=None,
-    floor: float = TRACK_FLOOR,
+    time_s, contact_force_N, *, source: str, model: str, shots=None, floor: float = TRACK_FLOOR
 ) -> pd.DataFrame:
     """The rows of ``ssw_track.csv`` for a batch of collisions of one chain.
 

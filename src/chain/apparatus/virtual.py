@@ -36,11 +36,7 @@ from chain.apparatus.virtual_settings import (
     VirtualExperiment,
     check_switches,
 )
-from chain.apparatus.virtual_shots import (
-    MAX_BATCH,
-    RECORD_OVERSAMPLING,
-    simulate_virtual_shots,
-)
+from chain.apparatus.virtual_shots import MAX_BATCH, RECORD_OVERSAMPLING, simulate_virtual_shots
 from chain.labels import VIRTUAL_LABEL
 
 __all__ = [

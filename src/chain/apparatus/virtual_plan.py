@@ -104,8 +104,7 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
                 )
             )
     plan = pd.DataFrame(
-        rows,
-        columns=["kind", "amplitude", "v_left_m_s", "v_right_m_s", "delay_s", "phase"],
+        rows, columns=["kind", "amplitude", "v_left_m_s", "v_right_m_s", "delay_s", "phase"]
     )
     plan.insert(0, "shot", np.arange(len(plan)))
     plan.insert(1, "file", [f"shot_{s:04d}.csv" for s in plan["shot"]])

@@ -11,11 +11,7 @@ import pandas as pd
 
 from chain.apparatus.lammps_shots import lammps_shots
 from chain.studies.mechanism_fits import analyse_per_estimator
-from chain.studies.mechanism_settings import (
-    granular_chain,
-    sweep_settings,
-    viscous_settings,
-)
+from chain.studies.mechanism_settings import granular_chain, sweep_settings, viscous_settings
 
 
 def run_sweep_setting(

@@ -23,10 +23,7 @@ SSW_METHOD = "residual"
 
 
 def sweep_table(
-    delay_fits: pd.DataFrame,
-    ssw_fits: pd.DataFrame,
-    eta_s: Mapping[str, float],
-    estimator: str,
+    delay_fits: pd.DataFrame, ssw_fits: pd.DataFrame, eta_s: Mapping[str, float], estimator: str
 ) -> pd.DataFrame:
     """C(N) and SSW slope(N) of every simulated model, one row per model and chain.
 
@@ -57,9 +54,7 @@ def sweep_table(
         columns={"slope": "ssw_slope", "slope_stderr": "ssw_slope_stderr", "n_points": "n_ssw"}
     )
     table = delays.rename(columns={"n_points": "n_delays"}).merge(
-        ssw[["model", "N", "ssw_slope", "ssw_slope_stderr", "n_ssw"]],
-        on=["model", "N"],
-        how="left",
+        ssw[["model", "N", "ssw_slope", "ssw_slope_stderr", "n_ssw"]], on=["model", "N"], how="left"
     )
     table["eta_s"] = table["model"].map(lambda name: eta_s.get(name, float("nan")))
     table["parity"] = ["even" if n % 2 == 0 else "odd" for n in table["N"]]

@@ -159,11 +159,7 @@ def _contrast(rows: pd.DataFrame) -> str:
 
 
 def mechanism_summary(
-    table: pd.DataFrame,
-    check: pd.DataFrame | None,
-    *,
-    friction: str,
-    reference: str,
+    table: pd.DataFrame, check: pd.DataFrame | None, *, friction: str, reference: str
 ) -> dict:
     """``{"verdict": two sentences, "rows": the table, "lammps_check": its rows,
     "friction_C": C with and without friction}`` (:func:`friction_c_rows`).

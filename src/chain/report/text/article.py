@@ -338,9 +338,7 @@ def setup_text(setup: Mapping | None) -> dict:
 
 
 def article_numbers(
-    summary: Mapping,
-    setup: Mapping | None = None,
-    provenance: Mapping | None = None,
+    summary: Mapping, setup: Mapping | None = None, provenance: Mapping | None = None
 ) -> dict:
     """Everything the article prints, as strings: the JSON that article.typ reads.
 
