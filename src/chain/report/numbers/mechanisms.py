@@ -10,7 +10,7 @@ from collections.abc import Mapping
 import pandas as pd
 
 #: A ratio to the frictionless (or candidate-off) value that counts as "significantly
-#: larger" (issue 24).
+#: larger" (the verdict and the mechanism figure's dotted mark).
 SIGNIFICANT_RATIO = 2.0
 
 
