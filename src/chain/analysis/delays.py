@@ -131,13 +131,8 @@ def _delay_row(shot, wave: str, incident, crossed, reference: tuple) -> dict:
     tof = crossed.T_s - incident.T_s if incident is not None and crossed is not None else math.nan
     ok = not reasons
     return {
-        "source": shot.source,
-        "model": shot.model,
-        "N": shot.N,
-        "shot": shot.shot,
-        "amplitude": shot.amplitude,
+        **shot._asdict(),
         "wave": wave,
-        "estimator": shot.estimator,
         "n_reference": n_ref,
         "F_m_N": f_m if ok else math.nan,
         "delay_us": (tof - tof_ref) * 1e6 if ok else math.nan,

@@ -7,8 +7,6 @@ column of the trace table, S2 the last. Roles (see ``docs/interfaces.md``): in a
 collision shot the 1st pulse at S1 is the incident LSTW and the 2nd the crossed RSTW; at
 S2 the 1st is the incident RSTW and the 2nd the crossed LSTW; a reference shot has one
 pulse per sensor, role ``reference``, wave LSTW.
-
-SI units inside; table columns carry their unit.
 """
 
 from __future__ import annotations

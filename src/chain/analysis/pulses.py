@@ -22,8 +22,6 @@ with one of the :data:`ESTIMATORS`:
 A measurement that cannot be made gives a :class:`PulseFit` with ``ok=False`` and a
 ``reason``, never an exception. :func:`chain.analysis.pulse_rows.pulse_table` applies
 both to every sensor signal of a trace table (the rows of ``pulses.csv``).
-
-SI units inside; table columns carry their unit.
 """
 
 from __future__ import annotations

@@ -345,16 +345,7 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
     where = (shot.source, shot.model, shot.N, shot.shot)
     crossed = context["lookup"].get((*where, sensor, "crossed"))
     incident = context["lookup"].get((*where, first, "incident"))
-    base = {
-        "source": shot.source,
-        "model": shot.model,
-        "N": shot.N,
-        "shot": shot.shot,
-        "amplitude": shot.amplitude,
-        "sensor": sensor,
-        "bead": context["bead_of"][sensor],
-        "wave": wave,
-    }
+    base = {**shot._asdict(), "sensor": sensor, "bead": context["bead_of"][sensor], "wave": wave}
     same = context["references_of"].get(tuple(getattr(shot, key) for key in _REFERENCE_KEY))
     reason = ""
     if crossed is None or not bool(crossed.ok):

@@ -1,10 +1,8 @@
 """Ablation of the virtual experiment: rerun it with one ingredient changed at a time.
 
 The virtual experiment (:mod:`chain.apparatus.virtual`, a MODEL of the apparatus) is
-the paper's simulation plus apparatus ingredients: strikers instead of a launched end
-bead, split sensor beads instead of a point readout, Kuwabara-Kono dissipation, noise
-and a digitiser, shot-to-shot speed mismatch and launch jitter, the 5 % acceptance
-protocol and its own range of amplitudes. A variant changes some of them
+the paper's simulation plus apparatus ingredients, the 5 % acceptance protocol and its
+own range of amplitudes. A variant changes some of them
 (:mod:`chain.pipeline.config.ablation` maps the config's ``ablation.variants`` to the
 settings of each chain). :func:`run_variant_shots` runs the virtual experiment of every
 chain with those settings (the same seed as the run, so a variant with no overrides

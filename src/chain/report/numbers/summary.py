@@ -1,10 +1,10 @@
-"""The run's headline numbers beside the paper's: ``summary.json`` and ``summary.md``.
+"""The run's headline numbers beside the paper's: ``summary.json``.
 
 Every number is computed from the run's tables and the closed forms of
 :mod:`chain.physics.theory`, except the paper's own values in :data:`PAPER`, quoted as
-printed. :func:`build_summary` gathers them into a JSON-ready dict, :func:`summary_json`
-writes it with sorted keys and fixed float formatting, and :func:`write_summary_json`
-writes ``summary.json`` atomically; :mod:`chain.report.text.markdown` writes the Markdown from it.
+printed. :func:`build_summary` gathers them into a JSON-ready dict and
+:func:`write_summary_json` writes it; :mod:`chain.report.text.markdown` writes
+``summary.md`` from it.
 """
 
 from __future__ import annotations
