@@ -82,27 +82,11 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
     rows = []
     for a in range(n_amp):
         for c in range(n_col):
-            rows.append(
-                (
-                    "collision",
-                    a,
-                    left[a, c],
-                    right[a, c],
-                    settings.right_delay_s + settings.timing_jitter_s * collision_draws[a, c, 2],
-                    collision_phase[a, c],
-                )
-            )
+            delay = settings.right_delay_s + settings.timing_jitter_s * collision_draws[a, c, 2]
+            rows.append(("collision", a, left[a, c], right[a, c], delay, collision_phase[a, c]))
         for r in range(n_ref):
-            rows.append(
-                (
-                    "reference",
-                    a,
-                    _speed(speeds[a], reference_draws[a, r], sigma_ref),
-                    0.0,
-                    0.0,
-                    reference_phase[a, r],
-                )
-            )
+            speed = _speed(speeds[a], reference_draws[a, r], sigma_ref)
+            rows.append(("reference", a, speed, 0.0, 0.0, reference_phase[a, r]))
     plan = pd.DataFrame(
         rows, columns=["kind", "amplitude", "v_left_m_s", "v_right_m_s", "delay_s", "phase"]
     )

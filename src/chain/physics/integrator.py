@@ -18,9 +18,9 @@ import numba
 import numpy as np
 
 from chain.errors import ParameterError, require_int, require_positive
-from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
+from chain.physics.kernels import _OK
 from chain.physics.launches import _lean_launches, _reference_launches, _run_launches
-from chain.physics.model import HERTZ, SPRING, ChainModel
+from chain.physics.model import ChainModel
 
 #: Default bound on the relative energy drift before a run is declared broken.
 DEFAULT_MAX_ENERGY_DRIFT = 1e-6
@@ -300,10 +300,6 @@ def _batch_array(name: str, values, n_particles: int) -> np.ndarray:
 
 __all__ = [
     "DEFAULT_MAX_ENERGY_DRIFT",
-    "EVENT_AFTERMATH",
-    "EVENT_SUBSTEPS",
-    "HERTZ",
-    "SPRING",
     "IntegrationError",
     "RawTrajectory",
     "integrate",
