@@ -14,8 +14,7 @@ the true errors and var(C) = 1 / sum(w g^2).
 
 The free power law is fitted in log-log (default): ln y = ln A + p ln x by
 :func:`line_fit` (the arithmetic of :func:`scipy.stats.linregress`, whose import costs
-a job a second; weighted least squares by ``numpy.polyfit`` when sigma is given, with
-sigma_ln y = sigma / y), right for a relative scatter; or with
+a job a second), right for a relative scatter; or with
 ``method="nonlinear"`` by ``scipy.optimize.curve_fit`` of A x^p on y itself, right for a
 constant absolute scatter. Both give the standard error of p from the residuals.
 
@@ -119,7 +118,7 @@ def fit_fixed_exponent(
     return _coefficient_fit(x**exponent, y, weight, exponent, sigma is not None and absolute_sigma)
 
 
-def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> CoefficientFit:
+def fit_proportional(x, y, sigma=None) -> CoefficientFit:
     """Least-squares slope of y = slope x (through the origin) with its standard error.
 
     Parameters
@@ -127,15 +126,14 @@ def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> Coeff
     x, y : array
         Abscissae and ordinates (e.g. F_m and the SSW amplitude, both in N).
     sigma : array, optional
-        Standard errors of y; None for unweighted least squares.
-    absolute_sigma : bool
-        As in :func:`fit_fixed_exponent`.
+        Standard errors of y, relative (the error is scaled by the reduced chi-square);
+        None for unweighted least squares.
     """
     x, y, weight = _points(x, y, sigma)
     n = x.size
     if n < MIN_POINTS_ONE_PARAMETER:
         return CoefficientFit(math.nan, math.nan, 1.0, n, math.nan)
-    return _coefficient_fit(x, y, weight, 1.0, sigma is not None and absolute_sigma)
+    return _coefficient_fit(x, y, weight, 1.0, absolute=False)
 
 
 def _coefficient_fit(basis, y, weight, exponent: float, absolute: bool) -> CoefficientFit:
@@ -152,22 +150,20 @@ def _coefficient_fit(basis, y, weight, exponent: float, absolute: bool) -> Coeff
     return CoefficientFit(coefficient, math.sqrt(variance), float(exponent), basis.size, rms)
 
 
-def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
-    """Least-squares y = A x^p with A and p free, and their standard errors (NaN with
-    fewer than 3 points).
+def fit_power_law(x, y, *, method: str = "loglog") -> PowerLawFit:
+    """Unweighted least-squares y = A x^p with A and p free, and their standard errors
+    (NaN with fewer than 3 points).
 
     Parameters
     ----------
     x, y : array
         Abscissae and ordinates, both > 0 (use |Delta| for delays).
-    sigma : array, optional
-        Standard errors of y; None for unweighted least squares.
     method : {"loglog", "nonlinear"}
         Straight line in ln y vs ln x, or nonlinear fit of y (module docstring).
     """
     if method not in POWER_LAW_METHODS:
         raise ParameterError(f"method must be one of {POWER_LAW_METHODS}, got {method!r}")
-    x, y, weight = _points(x, y, sigma)
+    x, y, _ = _points(x, y, None)
     n = x.size
     if n < MIN_POINTS_TWO_PARAMETERS:
         return PowerLawFit(math.nan, math.nan, math.nan, math.nan, n, method)
@@ -175,16 +171,7 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
         raise ParameterError("x and y must be > 0 for a power-law fit")
     log_x, log_y = np.log(x), np.log(y)
     if method == "loglog":
-        if sigma is None:
-            exponent, log_a, exponent_error, log_a_error = line_fit(log_x, log_y)
-        else:
-            # sigma of ln y is sigma / y; polyfit weights multiply the residuals.
-            log_weight = y * np.sqrt(weight)
-            coefficients, covariance = np.polyfit(log_x, log_y, 1, w=log_weight, cov="unscaled")
-            residual = log_weight * (log_y - np.polyval(coefficients, log_x))
-            covariance = covariance * float(np.sum(residual**2)) / (n - 2)
-            exponent, log_a = coefficients
-            exponent_error, log_a_error = np.sqrt(np.diag(covariance))
+        exponent, log_a, exponent_error, log_a_error = line_fit(log_x, log_y)
         prefactor = math.exp(log_a)
         return PowerLawFit(
             prefactor,
@@ -198,11 +185,7 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
 
     start = fit_power_law(x, y, method="loglog")
     params, covariance = curve_fit(
-        lambda u, a, p: a * u**p,
-        x,
-        y,
-        p0=(start.prefactor, start.exponent),
-        sigma=None if sigma is None else 1.0 / np.sqrt(weight),
+        lambda u, a, p: a * u**p, x, y, p0=(start.prefactor, start.exponent)
     )
     errors = np.sqrt(np.diag(covariance))
     return PowerLawFit(

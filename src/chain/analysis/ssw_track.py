@@ -257,10 +257,8 @@ def track_collision(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> d
     return {"LSTW": left, "RSTW": right}
 
 
-def ssw_track_table(
-    time_s, contact_force_N, *, source: str, model: str, shots=None, floor: float = TRACK_FLOOR
-) -> pd.DataFrame:
-    """The rows of ``ssw_track.csv`` for a batch of collisions of one chain.
+def ssw_track_table(time_s, contact_force_N, *, source: str, model: str) -> pd.DataFrame:
+    """The rows of ``ssw_track.csv`` for a batch of collisions of one chain, shots 0..B-1.
 
     Parameters
     ----------
@@ -270,10 +268,6 @@ def ssw_track_table(
         Contact forces of B collision shots, N (``SimulationResult.contact_force``).
     source, model : str
         Values of the ``source`` and ``model`` columns.
-    shots : sequence of int, optional
-        Shot id of each collision (default 0..B-1).
-    floor : float
-        Least SSW height and prominence as a fraction of F_m.
 
     Returns
     -------
@@ -287,11 +281,10 @@ def ssw_track_table(
         raise ParameterError(
             f"contact_force_N must be (shots, samples, contacts), got {force.shape}"
         )
-    shots = np.arange(force.shape[0]) if shots is None else np.asarray(shots)
     frames = []
-    for shot, forces in zip(shots, force):
-        for wave, found in track_collision(time_s, forces, floor=floor).items():
-            frames.append(_track_rows(found, source, model, forces.shape[1] + 1, int(shot), wave))
+    for shot, forces in enumerate(force):
+        for wave, found in track_collision(time_s, forces).items():
+            frames.append(_track_rows(found, source, model, forces.shape[1] + 1, shot, wave))
     return pd.concat(frames, ignore_index=True)[list(TRACK_COLUMNS)]
 
 
