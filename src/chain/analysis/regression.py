@@ -194,7 +194,8 @@ def fit_power_law(x, y, *, method: str = "loglog") -> PowerLawFit:
 
 
 def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
-    """Unweighted least-squares line y = slope x + intercept, and standard errors.
+    """Unweighted least-squares line y = slope x + intercept: (slope, intercept, stderr
+    of the slope, stderr of the intercept).
 
     The arithmetic of :func:`scipy.stats.linregress` (scipy 1.17), operation for
     operation, so that the numbers are the same to the last bit (a test compares them),
@@ -204,11 +205,6 @@ def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
     ----------
     x, y : array
         At least 3 points, x not all equal; units of y per unit of x for the slope.
-
-    Returns
-    -------
-    tuple of float
-        slope, intercept, stderr of the slope, stderr of the intercept.
     """
     if np.amax(x) == np.amin(x):
         raise ParameterError("cannot fit a line if all x values are identical")

@@ -89,8 +89,9 @@ def smoothed_interior(signal: np.ndarray, length: int, lo: int, hi: int) -> np.n
 
 
 def smoother(time_s, tau_s: float, lo: int, hi: int):
-    """Quadratic Savitzky-Golay smoothing tau/2 long that is right on samples [lo, hi),
-    and its :func:`noise_gain`.
+    """Quadratic Savitzky-Golay smoothing tau/2 long that is right on samples [lo, hi):
+    (a function of an array of ``len(time_s)`` values that returns it smoothed, its
+    :func:`noise_gain`).
 
     Where no window of [lo, hi) reaches the record's ends, only those samples are
     smoothed (:func:`smoothed_interior`: the filter's own values, bit for bit) and the
@@ -105,13 +106,6 @@ def smoother(time_s, tau_s: float, lo: int, hi: int):
         Pulse time scale, s.
     lo, hi : int
         The samples that will be read, [lo, hi).
-
-    Returns
-    -------
-    smooth : callable
-        Array of ``len(time_s)`` values -> the smoothed array, same unit.
-    gain : float
-        Noise gain of the smoothing.
     """
     from scipy.signal import savgol_filter
 

@@ -78,7 +78,8 @@ def analyse_datasets(
     series: str = VIRTUAL_SERIES,
 ) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
     """Load a variant's shots, fit their pulses per chain and select the collisions
-    with ``tolerance``, as the pipeline does.
+    with ``tolerance``, as the pipeline does: (the trace table of each chain, their
+    pulse rows, the shot selection or None with ``tolerance`` None).
 
     Parameters
     ----------
@@ -86,15 +87,6 @@ def analyse_datasets(
         Dataset folders in the measured-trace format, one per chain.
     tolerance, estimators, series
         As :func:`run_variant_shots`.
-
-    Returns
-    -------
-    traces : list of DataFrame
-        The trace table of each chain.
-    pulses : DataFrame
-        Their pulse rows (:func:`chain.analysis.pulse_rows.pulse_table`).
-    selection : DataFrame or None
-        The shot selection (None with ``tolerance`` None).
     """
     traces = [load_dataset(folder, name=series) for folder in datasets]
     table = pd.concat(
@@ -112,8 +104,10 @@ def variant_fits(
     tolerance: float | None,
     estimators: Sequence[str],
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """A variant's delay fits and SSW fits at S2 with each estimator, each with the
-    shot selection the acceptance protocol makes with that estimator.
+    """A variant's delay fits (:func:`chain.analysis.recipe.fit_pulses` rows) and SSW
+    fits at S2 (:func:`chain.studies.mechanism_fits.variant_ssw_fits` rows with an
+    ``estimator`` column) with each estimator, one after the other, each with the shot
+    selection the acceptance protocol makes with that estimator.
 
     Every estimator is fitted so that a what-if choosing another main estimator
     reuses the variant (its simulation is the costly part); the tables reporting it
@@ -129,14 +123,6 @@ def variant_fits(
         Acceptance tolerance of the 5 % protocol (relative); None keeps every shot.
     estimators : sequence of str
         Pulse estimators.
-
-    Returns
-    -------
-    fits : DataFrame
-        :func:`chain.analysis.recipe.fit_pulses` rows, one estimator after the other.
-    ssw_fits : DataFrame
-        :func:`chain.studies.mechanism_fits.variant_ssw_fits` rows, likewise, with an
-        ``estimator`` column.
     """
     fits, ssw_fits = [], []
     for estimator in estimators:
