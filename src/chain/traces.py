@@ -65,7 +65,8 @@ def sensor_beads(table: pd.DataFrame) -> list[int]:
 
 
 def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataFrame:
-    """Check ``table`` against the trace format; return it with canonical dtypes.
+    """Check ``table`` against the trace format; return it with canonical dtypes, or
+    raise :class:`TraceFormatError` naming the column, shot or value that is wrong.
 
     Parameters
     ----------
@@ -73,11 +74,6 @@ def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataF
         A trace table.
     where : str
         Name used in error messages (e.g. the file path).
-
-    Raises
-    ------
-    TraceFormatError
-        Naming the column, shot or value that is wrong.
     """
     missing = [c for c in META_COLUMNS if c not in table.columns]
     if missing:

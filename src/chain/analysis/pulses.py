@@ -291,8 +291,7 @@ def measure_pulse(
     """The largest pulse of a signal measured with each of several ``estimators``
     (names from :data:`ESTIMATORS`): what :func:`fit_pulse`, whose other parameters it
     takes (s, N), gives for each, with the checks, the baseline and the width at half
-    maximum (the initial tau) found once for all. Returns {estimator: PulseFit}.
-    """
+    maximum (the initial tau) found once for all. Returns {estimator: PulseFit}."""
     unknown = [e for e in estimators if e not in ESTIMATORS]
     if unknown:
         raise ParameterError(f"estimators must be among {ESTIMATORS}, got {unknown}")
@@ -420,8 +419,7 @@ def _peak_estimate(time, signal, peak, tau0, noise, dt) -> PulseFit:
     """Vertex of the least-squares parabola (quadratic Savitzky-Golay) through the
     samples within tau/4 of the maximum (see the module docstring). ``peak`` is the
     largest sample, ``tau0`` tau from its width at half maximum (s), also the value
-    returned; ``dt`` the sampling interval, s.
-    """
+    returned; ``dt`` the sampling interval, s."""
     length = max(round(0.5 * tau0 / dt) | 1, 3)
     half = length // 2
     lo, hi = max(peak - half, half), min(peak + half + 1, len(signal) - half)

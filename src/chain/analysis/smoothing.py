@@ -37,13 +37,8 @@ def savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
 
 @lru_cache(maxsize=64)
 def smoothing_coefficients(length: int) -> np.ndarray:
-    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only).
-
-    Parameters
-    ----------
-    length : int
-        Odd window length, samples.
-    """
+    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only), for an
+    odd window ``length`` in samples."""
     from scipy.signal import savgol_coeffs
 
     coefficients = savgol_coeffs(length, 2)
@@ -53,14 +48,8 @@ def smoothing_coefficients(length: int) -> np.ndarray:
 
 @lru_cache(maxsize=64)
 def noise_gain(length: int) -> float:
-    """Standard deviation of ``savgol_filter(x, length, 2)`` on white noise of unit
-    standard deviation (the root sum of squares of its coefficients).
-
-    Parameters
-    ----------
-    length : int
-        Odd window length, samples.
-    """
+    """Standard deviation of ``savgol_filter(x, length, 2)`` (odd ``length``, samples) on
+    white noise of unit standard deviation (the root sum of squares of its coefficients)."""
     return math.sqrt(float(np.sum(smoothing_coefficients(length) ** 2)))
 
 

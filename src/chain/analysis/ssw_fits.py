@@ -1,7 +1,6 @@
 """SSW fits: SSW = slope x F_m per series and chain with a statistical and a systematic
 error, whether the SSW is resolved at each sensor, and the even / odd ratio of the
-slopes. Reads ``ssw.csv`` rows (:func:`chain.analysis.ssw.ssw_table`); computes no SSW.
-"""
+slopes. Reads ``ssw.csv`` rows (:func:`chain.analysis.ssw.ssw_table`); computes no SSW."""
 
 from __future__ import annotations
 

@@ -197,13 +197,7 @@ def read_shot_csv(
     samples: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Read and check one shot file (rules: :func:`shot_file_problems`): (time (S,) s,
-    volts (n_sensors, S) V).
-
-    Raises
-    ------
-    MeasuredDataError
-        Listing every problem, one line each, naming the file and the line.
-    """
+    volts (n_sensors, S) V), or :class:`MeasuredDataError` listing every problem."""
     data, problems = shot_file_problems(path, sensor_beads, sampling_interval_s, samples)
     if problems:
         raise MeasuredDataError(problem_list(problems))

@@ -34,15 +34,9 @@ def plan_shots(settings: VirtualExperiment) -> pd.DataFrame:
 
 
 def collision_speeds(settings: VirtualExperiment) -> tuple[np.ndarray, np.ndarray]:
-    """True impact speeds of the left and right strikers of the collision shots, m/s,
-    shape (amplitudes, collision shots): the plan's (:func:`plan_shots`), drawn alone
-    (they are its first draws), for a check that needs no more of it.
-
-    Parameters
-    ----------
-    settings : VirtualExperiment
-        The apparatus and the shot plan.
-    """
+    """True impact speeds of the left and right strikers of the collision shots of
+    ``settings``, m/s, shape (amplitudes, collision shots): the plan's (:func:`plan_shots`),
+    drawn alone (they are its first draws), for a check that needs no more of it."""
     shape = (settings.nominal_speeds.size, settings.collision_shots, 3)
     return _collision_speeds(settings, np.random.default_rng(settings.seed).standard_normal(shape))
 

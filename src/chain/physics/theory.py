@@ -285,7 +285,9 @@ def _reduced_mass(mass_a: float, mass_b: float) -> float:
 
 
 def ballistic_constants(material: str, radius_m: float) -> dict[str, float]:
-    """Contact stiffness, bead mass and the two ballistic delay constants of a run.
+    """Contact stiffness, bead mass and the two ballistic delay constants of a run:
+    ``kappa_N_m1_5`` (N/m^1.5), ``bead_mass_kg``, ``C_bal_paper_us_N16`` (Eq. 6 as
+    printed) and ``C_bal_exact_us_N16`` (the exact Hertz contact time), us N^(1/6).
 
     Parameters
     ----------
@@ -293,13 +295,6 @@ def ballistic_constants(material: str, radius_m: float) -> dict[str, float]:
         Bead material name (:data:`chain.physics.materials.MATERIALS`).
     radius_m : float
         Bead radius, m.
-
-    Returns
-    -------
-    dict
-        ``kappa_N_m1_5`` (N/m^1.5), ``bead_mass_kg``, ``C_bal_paper_us_N16`` (Eq. 6 as
-        printed) and ``C_bal_exact_us_N16`` (the same argument with the exact Hertz
-        contact time of two free beads), in us N^(1/6).
     """
     beads = get_material(material)
     return {

@@ -33,14 +33,9 @@ TRACE_TOLERANCE = 1e-4
 
 
 def trace_difference(first: pd.DataFrame, second: pd.DataFrame) -> tuple[float, float]:
-    """Largest |difference| of two trace tables of the same shots, sample by sample:
-    (over the shot's F_m, in N). F_m of a shot is its largest sensor force in ``first``.
-
-    Parameters
-    ----------
-    first, second : DataFrame
-        Trace tables with the same shots, sensors and sample times.
-    """
+    """Largest |difference| of two trace tables with the same shots, sensors and sample
+    times, sample by sample: (over the shot's F_m, in N). F_m of a shot is its largest
+    sensor force in ``first``."""
     columns = [c for c in first.columns if c.startswith("force_bead")]
     worst_ratio, worst = 0.0, 0.0
     for shot, group in first.groupby("shot", sort=True):

@@ -1,7 +1,6 @@
 """One setting of the mechanism study's friction/rotation (or viscous) sweep on one
 chain, run by LAMMPS (:mod:`chain.physics.lammps_engine`, optional) and analysed as
-every other series. This module maps config keys and knows no Snakemake.
-"""
+every other series. This module maps config keys and knows no Snakemake."""
 
 from __future__ import annotations
 

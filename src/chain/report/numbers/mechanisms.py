@@ -64,15 +64,10 @@ def friction_sentence(table: pd.DataFrame, mechanism: str) -> str:
 
 
 def friction_c_rows(table: pd.DataFrame, mechanism: str) -> list[dict]:
-    """C with track and bead friction beside the frictionless C, per chain and setting.
-
-    Returns
-    -------
-    list of dict
-        ``N``, ``setting``, ``C_frictionless`` and ``C`` (µs N^(1/6), None where not
-        fitted), for each frictional row of ``mechanism`` (the first setting of a
-        mechanism is its frictionless reference, as in :func:`friction_sentence`).
-    """
+    """C with track and bead friction beside the frictionless C, per chain and setting:
+    ``N``, ``setting``, ``C_frictionless`` and ``C`` (µs N^(1/6), None where not fitted)
+    of each frictional row of ``mechanism`` (the first setting of a mechanism is its
+    frictionless reference, as in :func:`friction_sentence`)."""
     rows = table[table["mechanism"] == mechanism]
     if rows.empty:
         return []
