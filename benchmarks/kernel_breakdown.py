@@ -1,4 +1,4 @@
-"""Where chain.simulate's time goes, against C (issue 25) and DOP853 (issue 14).
+"""Where chain.simulate's time goes, against C and DOP853.
 
 Run from the repository root::
 
