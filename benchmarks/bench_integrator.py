@@ -140,13 +140,17 @@ def dop853(rtol: float, velocity, samples):
     return (kappa * overlap**1.5).T, drift
 
 
-def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
-    """A copy of chain.physics.kernels with another refinement scheme, as a module."""
+def patched_kernel(
+    folder: Path, substeps: int, aftermath: int, refine: bool, edits=(), name: str = ""
+):
+    """A copy of chain.physics.kernels with another refinement scheme and the source
+    ``edits`` ((old, new) pairs), compiled with numba's cache off, as a module."""
     source = Path(kernels.__file__).read_text()
     edits = [
         ("EVENT_SUBSTEPS = 16", f"EVENT_SUBSTEPS = {substeps}"),
         ("EVENT_AFTERMATH = 3", f"EVENT_AFTERMATH = {aftermath}"),
-        ("cache=True", "cache=False"),
+        ("cache=CACHE", "cache=False"),
+        *edits,
     ]
     if not refine:  # detect events (same work, refined code present) but keep the coarse step
         edits.append(
@@ -158,7 +162,7 @@ def patched_kernel(folder: Path, substeps: int, aftermath: int, refine: bool):
     for old, new in edits:
         assert old in source, f"kernels.py changed: {old!r} not found"
         source = source.replace(old, new)
-    name = f"kernel_{substeps}_{aftermath}_{int(refine)}"
+    name = name or f"kernel_{substeps}_{aftermath}_{int(refine)}"
     path = folder / f"{name}.py"
     path.write_text(source)
     spec = importlib.util.spec_from_file_location(name, path)

@@ -1,4 +1,4 @@
-"""Where chain.simulate's time goes, against C (issue 25) and DOP853 (issue 14).
+"""Where chain.simulate's time goes, against C and DOP853.
 
 Run from the repository root::
 
@@ -26,6 +26,11 @@ velocity and the energies recorded every 1 us) at the default step. CPU times, b
   force and energy difference from the converged scheme (64 substeps, 12 steps after)
   at the same dt, the error the scheme itself adds at contact events.
 
+With ``--split``, only what splitting the step loop (``kernels._integrate_part``, 62
+lines of code) into named steps would cost: the loop as it is against a copy whose
+(sub)steps of one step are a helper of their own (:func:`split_edits`), elastic and
+Kuwabara-Kono, same bits checked; writes ``kernel_split.json``.
+
 A diagnostic, not a test: it asserts only that the patched lines still exist.
 """
 
@@ -34,6 +39,8 @@ from __future__ import annotations
 import argparse
 import math
 import tempfile
+import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +50,7 @@ from measure import C_FLAGS, MIN_REPEAT, Conditions, Figure, best_times, load_c,
 from chain.physics import kernels
 from chain.physics.builders import uniform_chain
 from chain.physics.integrator import integrate
+from chain.physics.kernels import EVENT_AFTERMATH, EVENT_SUBSTEPS
 from chain.physics.launches import _lean_params, _outputs
 from chain.physics.model import launch_velocities
 from chain.physics.simulation import default_time_step, simulate
@@ -63,9 +71,106 @@ SCHEMES = (
 CONVERGED = "64 substeps, aftermath 12"
 
 
+def split_edits(source: str) -> list:
+    """Edits of kernels.py's ``source`` that split its step loop: the (sub)steps of one
+    step (from ``h = dt / substeps`` to ``in_y = not in_y``) move into a helper,
+    ``_substeps``, compiled once by numba and inlined by LLVM (forceinline) as
+    ``_plain_step`` is; the loop calls it."""
+    first, last = "            h = dt / substeps\n", "                in_y = not in_y\n"
+    start = source.index(first)
+    block = source[start : source.index(last, start) + len(last)]
+    arguments = (
+        "in_y, x_u, x_v, x_acc, y_u, y_v, y_acc, work, slope, dt, substeps, "
+        "im, k, c, keys, springs, walls, drag"
+    )
+    helper = (
+        "@numba.njit(cache=False, forceinline=True)\n"
+        f"def _substeps({arguments}):\n"
+        f"{textwrap.indent(textwrap.dedent(block), '    ')}"
+        "    return increment, end, varied, in_y\n\n\n"
+    )
+    call = f"            increment, end, varied, in_y = _substeps({arguments})\n"
+    return [(block, call), ("@compile_once.shared\n", helper + "@compile_once.shared\n")]
+
+
+def split_cost(repeat: int, speed: float) -> None:
+    """The step loop whole (as in kernels.py) against split (:func:`split_edits`), both
+    copies compiled here with the cache off, for an elastic and a Kuwabara-Kono chain
+    (the paper's eta) launched at ``speed`` m/s: the first call's CPU time (the
+    compile, after a third copy compiled the shared right-hand side) and the best of
+    ``repeat`` interleaved rounds. Writes kernel_split.json."""
+    conditions = Conditions()
+    conditions.sample("before")
+    source = Path(kernels.__file__).read_text()
+    folder = Path(tempfile.mkdtemp())
+    copies = {
+        name: patched_kernel(folder, EVENT_SUBSTEPS, EVENT_AFTERMATH, True, edits, name)
+        for name, edits in (("warm_up", ()), ("whole", ()), ("split", split_edits(source)))
+    }
+    contenders, compile_s, runs = {}, {}, {}
+    links, particles = np.arange(N_BEADS - 1), np.arange(N_BEADS)
+    for kind, eta in (("elastic", 0.0), ("Kuwabara-Kono", 0.58e-6)):
+        model = uniform_chain(N_BEADS, eta=eta)
+        velocity = launch_velocities(model, speed, speed)
+        dt = RECORD_INTERVAL / math.ceil(RECORD_INTERVAL / default_time_step(model, speed))
+        every = round(RECORD_INTERVAL / dt)
+        n_steps = math.ceil(DURATION / dt - 1e-9)
+        params = _lean_params(model)
+        for name, module in copies.items():
+            out = tuple(o[0] for o in _outputs(1, n_steps // every + 1, N_BEADS - 1, N_BEADS))
+
+            def run(module=module, out=out, velocity=velocity[0], params=params, dt=dt,
+                    n_steps=n_steps, every=every):  # fmt: skip
+                u, v = np.zeros(N_BEADS), velocity.copy()
+                status = module._integrate_one(
+                    u, v, params, dt, n_steps, every, links, particles, out
+                )
+                return [*out, u, v], status
+
+            start = time.process_time()
+            runs[name, kind] = run()
+            compile_s[name, kind] = time.process_time() - start
+            if name != "warm_up":
+                contenders[name, kind] = run
+    best = best_times(contenders, repeat)
+    conditions.sample("after")
+    figures = []
+    for kind in ("elastic", "Kuwabara-Kono"):
+        (whole, whole_status), (split, split_status) = runs["whole", kind], runs["split", kind]
+        same = whole_status == split_status and all(map(np.array_equal, whole, split))
+        ratio = best["split", kind] / best["whole", kind]
+        extra = compile_s["split", kind] - compile_s["whole", kind]
+        print(
+            f"{kind}: whole {best['whole', kind] * 1e3:.3f} ms, split "
+            f"{best['split', kind] * 1e3:.3f} ms (split / whole {ratio:.4f}, best of "
+            f"{repeat}); first call whole {compile_s['whole', kind]:.2f} s, split "
+            f"{compile_s['split', kind]:.2f} s; same bits: {same}"
+        )
+        figures += [
+            Figure(
+                f"step loop split / whole, {kind}",
+                ratio,
+                "x",
+                "the same arithmetic, the helper inlined by LLVM"
+                + ("" if same else "; BITS DIFFER"),
+                "the whole step loop (kernels.py), same rounds",
+            ),
+            Figure(
+                f"step loop split, extra compile, {kind}",
+                extra,
+                "s",
+                "numba types and lowers the helper on its own before LLVM inlines it",
+            ),
+        ]
+    write_result("kernel_split", figures, conditions)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=MIN_REPEAT)
+    parser.add_argument(
+        "--split", action="store_true", help="only what splitting the step loop costs"
+    )
     parser.add_argument("--eta", type=float, default=0.0, help="Kuwabara-Kono time, s")
     parser.add_argument("--speed", type=float, default=0.3, help="V0, m/s")
     parser.add_argument(
@@ -76,6 +181,9 @@ def main() -> None:
         help="also time DOP853 (bench_integrator.dop853, elastic only) at these rtol",
     )
     args = parser.parse_args()
+    if args.split:
+        split_cost(args.repeat, args.speed)
+        return
     conditions = Conditions()
     conditions.sample("before")
     model = uniform_chain(N_BEADS, eta=args.eta)

@@ -11,16 +11,18 @@ import importlib
 from collections.abc import Callable, Mapping
 
 
-def lazy_exports(package: str, exports: Mapping[str, str]) -> tuple[Callable, Callable, list]:
+def lazy_exports(package: str, modules: Mapping[str, str]) -> tuple[Callable, Callable, list]:
     """``__getattr__``, ``__dir__`` and ``__all__`` of a package that re-exports names.
 
     Parameters
     ----------
     package : str
         The package's ``__name__``.
-    exports : mapping of str to str
-        Public name -> module that defines it (absolute, ``chain.physics.model``).
+    modules : mapping of str to str
+        Module (absolute, ``chain.physics.model``) -> the public names it defines that
+        the package exports, separated by spaces.
     """
+    exports = {name: module for module, names in modules.items() for name in names.split()}
 
     def __getattr__(name: str):
         try:

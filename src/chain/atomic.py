@@ -66,12 +66,9 @@ def _umask() -> int:
 @contextmanager
 def temporary_beside(path: Path, directory: bool = False) -> Iterator[Path]:
     """A new private file (or folder) beside ``path``, named ``.<name>.<random>``,
-    removed if the block raises or is interrupted.
-
-    The name is chosen before the file is made, so that an interruption at any moment
-    finds it: ``tempfile.mkstemp`` makes the file first and returns its name after, and
-    a signal in between (a watcher of the folder signals as soon as a file appears) left
-    it where no clean-up knew it.
+    removed if the block raises or is interrupted. The name is chosen before the file is
+    made (``tempfile.mkstemp`` returns it after), so that an interruption at any moment
+    finds it.
 
     Parameters
     ----------
@@ -133,11 +130,18 @@ def write_text_atomic(text: str, path: str | os.PathLike) -> None:
     path : path
         Destination; parent folders are created.
     """
+    with _atomic_text(path) as stream:
+        stream.write(text)
+
+
+@contextmanager
+def _atomic_text(path: str | os.PathLike) -> Iterator:
+    """A UTF-8 text stream (line endings as written) into :func:`atomic_output`."""
     with (
         atomic_output(path) as temporary,
-        open(temporary, "w", encoding="utf-8", newline="") as stream,
+        open(temporary, "w", encoding="utf-8", newline="") as out,
     ):
-        stream.write(text)
+        yield out
 
 
 def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
@@ -154,10 +158,7 @@ def write_csv_atomic(table: pd.DataFrame, path: str | os.PathLike) -> None:
     """
     from chain.csv_text import csv_chunks  # here: it imports pandas, which a table has loaded
 
-    with (
-        atomic_output(path) as temporary,
-        open(temporary, "w", encoding="utf-8", newline="") as stream,
-    ):
+    with _atomic_text(path) as stream:
         stream.writelines(csv_chunks(table))
 
 

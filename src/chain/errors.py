@@ -23,24 +23,23 @@ class ConfigError(ValueError):
 
 
 def require_positive(name: str, value: float) -> float:
-    """Return ``value`` as a float, or raise :class:`ParameterError` naming ``name``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number) or number <= 0.0:
-        raise ParameterError(f"{name} must be a positive finite number, got {value!r}")
-    return number
+    """Return ``value`` as a float > 0, or raise :class:`ParameterError` naming ``name``."""
+    return _finite_number(name, value, zero_allowed=False)
 
 
 def require_nonnegative(name: str, value: float) -> float:
-    """Return ``value`` as a float, or raise :class:`ParameterError` naming ``name``."""
+    """Return ``value`` as a float >= 0, or raise :class:`ParameterError` naming ``name``."""
+    return _finite_number(name, value, zero_allowed=True)
+
+
+def _finite_number(name: str, value, zero_allowed: bool) -> float:
     try:
         number = float(value)
     except (TypeError, ValueError):
         raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number) or number < 0.0:
-        raise ParameterError(f"{name} must be a non-negative finite number, got {value!r}")
+    if not math.isfinite(number) or number < 0.0 or (number == 0.0 and not zero_allowed):
+        kind = "non-negative" if zero_allowed else "positive"
+        raise ParameterError(f"{name} must be a {kind} finite number, got {value!r}")
     return number
 
 

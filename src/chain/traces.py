@@ -36,18 +36,10 @@ from chain.atomic import write_csv_atomic
 from chain.errors import bead_number_problem
 from chain.sampling import TIME_STEP_TOLERANCE
 
+#: Columns that name one shot, first in every table with a row per shot.
+SHOT_COLUMNS = ("source", "model", "N", "shot", "kind", "amplitude")
 #: Columns every trace table has, in order, before the sensor columns.
-META_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "v0_left_m_s",
-    "v0_right_m_s",
-    "t_s",
-)
+META_COLUMNS = (*SHOT_COLUMNS, "v0_left_m_s", "v0_right_m_s", "t_s")
 SOURCES = ("simulation", "experiment", "lammps")
 KINDS = ("collision", "reference")
 _SENSOR_COLUMN = re.compile(r"^force_bead(\d+)_N$")
@@ -73,7 +65,8 @@ def sensor_beads(table: pd.DataFrame) -> list[int]:
 
 
 def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataFrame:
-    """Check ``table`` against the trace format; return it with canonical dtypes.
+    """Check ``table`` against the trace format; return it with canonical dtypes, or
+    raise :class:`TraceFormatError` naming the column, shot or value that is wrong.
 
     Parameters
     ----------
@@ -81,11 +74,6 @@ def validate_traces(table: pd.DataFrame, where: str = "trace table") -> pd.DataF
         A trace table.
     where : str
         Name used in error messages (e.g. the file path).
-
-    Raises
-    ------
-    TraceFormatError
-        Naming the column, shot or value that is wrong.
     """
     missing = [c for c in META_COLUMNS if c not in table.columns]
     if missing:

@@ -27,40 +27,15 @@ from chain.analysis.selection import GROUP as _GROUP
 from chain.analysis.selection import apply_selection
 
 #: Columns of :func:`delay_table`, in order (the last three are extras).
-DELAY_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "amplitude",
-    "wave",
-    "estimator",
-    "F_m_N",
-    "delay_us",
-    "tof_crossed_us",
-    "tof_reference_us",
-    "n_reference",
-    "ok",
-    "reason",
-    "F_m_stderr_N",
-    "delay_stderr_us",
-    "F_crossed_N",
+DELAY_COLUMNS = tuple(
+    "source model N shot amplitude wave estimator F_m_N delay_us tof_crossed_us "
+    "tof_reference_us n_reference ok reason F_m_stderr_N delay_stderr_us F_crossed_N".split()
 )
 
 #: Columns of :func:`delay_fit_table`, in order (after ``n_points``: extras).
-DELAY_FIT_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "estimator",
-    "C_us_N16",
-    "C_stderr_us_N16",
-    "exponent",
-    "exponent_stderr",
-    "n_points",
-    "prefactor_free_us",
-    "prefactor_free_stderr_us",
-    "rms_residual_us",
+DELAY_FIT_COLUMNS = tuple(
+    "source model N estimator C_us_N16 C_stderr_us_N16 exponent exponent_stderr n_points "
+    "prefactor_free_us prefactor_free_stderr_us rms_residual_us".split()
 )
 
 #: (first sensor met, sensor where the crossed wave is read) per wave.
@@ -156,13 +131,8 @@ def _delay_row(shot, wave: str, incident, crossed, reference: tuple) -> dict:
     tof = crossed.T_s - incident.T_s if incident is not None and crossed is not None else math.nan
     ok = not reasons
     return {
-        "source": shot.source,
-        "model": shot.model,
-        "N": shot.N,
-        "shot": shot.shot,
-        "amplitude": shot.amplitude,
+        **shot._asdict(),
         "wave": wave,
-        "estimator": shot.estimator,
         "n_reference": n_ref,
         "F_m_N": f_m if ok else math.nan,
         "delay_us": (tof - tof_ref) * 1e6 if ok else math.nan,
@@ -187,7 +157,8 @@ def _why(pulse) -> str:
 
 
 def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
-    """Fits of |Delta| against F_m (the rows of ``delay_fits.csv``).
+    """Fits of |Delta| against F_m (the rows of ``delay_fits.csv``, columns
+    :data:`DELAY_FIT_COLUMNS`).
 
     Per (source, model, N, estimator), and pooled over N (``N = "pooled"``) per
     (source, model, estimator), from the ``ok`` rows of both waves:
@@ -206,11 +177,6 @@ def delay_fit_table(delays: pd.DataFrame) -> pd.DataFrame:
     ----------
     delays : DataFrame
         ``delays.csv`` rows (:func:`delay_table`).
-
-    Returns
-    -------
-    DataFrame
-        Columns :data:`DELAY_FIT_COLUMNS`.
     """
     rows = []
     groups = [(keys, group) for keys, group in delays.groupby([*_GROUP, "estimator"], sort=True)]

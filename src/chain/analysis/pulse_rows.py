@@ -7,18 +7,13 @@ column of the trace table, S2 the last. Roles (see ``docs/interfaces.md``): in a
 collision shot the 1st pulse at S1 is the incident LSTW and the 2nd the crossed RSTW; at
 S2 the 1st is the incident RSTW and the 2nd the crossed LSTW; a reference shot has one
 pulse per sensor, role ``reference``, wave LSTW.
-
-SI units inside; table columns carry their unit.
 """
 
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 
 from chain.analysis.pulses import (
-    DEFAULT_MIN_SNR,
-    DEFAULT_REL_PROMINENCE,
     ESTIMATORS,
     PulseFit,
     estimate_baseline,
@@ -26,48 +21,23 @@ from chain.analysis.pulses import (
     measure_pulse,
 )
 from chain.errors import ParameterError
-from chain.traces import iter_shots, sensor_beads
+from chain.traces import SHOT_COLUMNS, iter_shots, sensor_beads
 
 #: Columns of :func:`pulse_table`, in order.
-PULSE_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "sensor",
-    "bead",
-    "role",
-    "wave",
-    "estimator",
-    "F_m_N",
-    "T_s",
-    "tau_s",
-    "F_m_stderr_N",
-    "T_stderr_s",
-    "tau_stderr_s",
-    "ok",
-    "reason",
-    "baseline_N",
-    "noise_N",
-    "n_samples",
+PULSE_COLUMNS = SHOT_COLUMNS + tuple(
+    "sensor bead role wave estimator F_m_N T_s tau_s F_m_stderr_N T_stderr_s tau_stderr_s "
+    "ok reason baseline_N noise_N n_samples".split()
 )
 
 
-def pulse_table(
-    traces: pd.DataFrame,
-    estimators=("fit_full",),
-    *,
-    rel_prominence: float = DEFAULT_REL_PROMINENCE,
-    min_snr: float = DEFAULT_MIN_SNR,
-    min_height_N: float = 0.0,
-) -> pd.DataFrame:
-    """The rows of ``pulses.csv``: every main pulse of every shot, per estimator.
+def pulse_table(traces: pd.DataFrame, estimators=("fit_full",)) -> pd.DataFrame:
+    """The rows of ``pulses.csv`` (:data:`PULSE_COLUMNS`): every main pulse of every
+    shot, per estimator.
 
-    Roles as in the module docstring. A pulse that is not detected gives rows with
-    ``ok`` False and reason "no pulse detected"; when a collision signal shows one
-    pulse only, it is taken as the incident one.
+    Roles as in the module docstring; pulses found with
+    :func:`chain.analysis.pulses.find_pulses`' default thresholds. A pulse that is not
+    detected gives rows with ``ok`` False and reason "no pulse detected"; when a
+    collision signal shows one pulse only, it is taken as the incident one.
 
     Parameters
     ----------
@@ -75,26 +45,11 @@ def pulse_table(
         A trace table (:mod:`chain.traces`).
     estimators : sequence of str
         Names from :data:`chain.analysis.pulses.ESTIMATORS`.
-    rel_prominence, min_snr, min_height_N
-        Detection thresholds, as in :func:`chain.analysis.pulses.find_pulses`
-        (fractions, noise standard deviations, N).
-
-    Returns
-    -------
-    DataFrame
-        ``source, model, N, shot, kind, amplitude, sensor, bead, role, wave, estimator,
-        F_m_N, T_s, tau_s, F_m_stderr_N, T_stderr_s, tau_stderr_s, ok, reason``, then
-        ``baseline_N, noise_N, n_samples``.
     """
     estimators = tuple(estimators)
     unknown = [e for e in estimators if e not in ESTIMATORS]
     if unknown:
         raise ParameterError(f"unknown estimators {unknown}; choose from {ESTIMATORS}")
-    thresholds = {
-        "rel_prominence": rel_prominence,
-        "min_snr": min_snr,
-        "min_height_N": min_height_N,
-    }
     beads = sensor_beads(traces)
     sensors = [("S1", beads[0])] + ([("S2", beads[-1])] if len(beads) > 1 else [])
     rows = []
@@ -108,31 +63,18 @@ def pulse_table(
             "amplitude": int(meta["amplitude"]),
         }
         for sensor, bead in sensors:
-            rows += _sensor_rows(
-                time,
-                forces[bead],
-                _roles(meta["kind"], sensor),
-                estimators,
-                thresholds,
-                {**shot_columns, "sensor": sensor, "bead": bead},
-            )
+            roles = _roles(meta["kind"], sensor)
+            columns = {**shot_columns, "sensor": sensor, "bead": bead}
+            rows += _sensor_rows(time, forces[bead], roles, estimators, columns)
     return pd.DataFrame(rows, columns=PULSE_COLUMNS)
 
 
-def _sensor_rows(
-    time: np.ndarray,
-    force: np.ndarray,
-    roles: list[tuple[str, str]],
-    estimators: tuple[str, ...],
-    thresholds: dict,
-    columns: dict,
-) -> list[dict]:
-    """The rows of one sensor signal of one shot: each expected pulse (``roles``, in
-    time order) measured with each estimator; ``columns`` are the shot and sensor ones."""
+def _sensor_rows(time, force, roles: list[tuple[str, str]], estimators, columns) -> list[dict]:
+    """The rows of one sensor signal (``time`` s, ``force`` N) of one shot: each expected
+    pulse (``roles``, in time order) measured with each estimator; ``columns`` are the
+    shot and sensor ones."""
     baseline, noise = estimate_baseline(time, force)
-    segments = find_pulses(
-        time, force, max_pulses=len(roles), baseline_N=baseline, noise_N=noise, **thresholds
-    )
+    segments = find_pulses(time, force, max_pulses=len(roles), baseline_N=baseline, noise_N=noise)
     rows = []
     for i, (role, wave) in enumerate(roles):
         if i < len(segments):

@@ -22,8 +22,6 @@ with one of the :data:`ESTIMATORS`:
 A measurement that cannot be made gives a :class:`PulseFit` with ``ok=False`` and a
 ``reason``, never an exception. :func:`chain.analysis.pulse_rows.pulse_table` applies
 both to every sensor signal of a trace table (the rows of ``pulses.csv``).
-
-SI units inside; table columns carry their unit.
 """
 
 from __future__ import annotations
@@ -188,7 +186,8 @@ def find_pulses(
     min_snr: float = DEFAULT_MIN_SNR,
     min_height_N: float = 0.0,
 ) -> list[PulseSegment]:
-    """The main pulses of a signal, in time order, as index ranges.
+    """The main pulses of a signal, in time order, as index ranges (empty when no pulse
+    clears the thresholds).
 
     Peaks are found with :func:`scipy.signal.find_peaks`; a main pulse has a prominence
     of at least ``rel_prominence`` times the largest excursion and a height above
@@ -214,20 +213,10 @@ def find_pulses(
         Least height of a pulse above the baseline, in noise standard deviations.
     min_height_N : float
         Least height above the baseline, N.
-
-    Returns
-    -------
-    list of PulseSegment
-        Empty when no pulse clears the thresholds.
     """
     time, force = _as_signal(time_s, force_N)
-    if baseline_N is None or noise_N is None:
-        estimated = estimate_baseline(time, force)
-        baseline_N = estimated[0] if baseline_N is None else baseline_N
-        noise_N = estimated[1] if noise_N is None else noise_N
-    # Imported here: scipy.signal takes most of a second to import (it loads
-    # scipy.stats), and many jobs import this module for its names only.
-    from scipy.signal import find_peaks, peak_widths
+    baseline_N, noise_N = _baseline(time, force, baseline_N, noise_N)
+    from scipy.signal import find_peaks, peak_widths  # see chain.analysis.smoothing
 
     signal = force - baseline_N
     largest = float(signal.max())
@@ -239,10 +228,7 @@ def find_pulses(
     # belong to one pulse, and pulses that close could not be told apart anyway.
     fwhm = _half_width_samples(signal, int(np.argmax(signal)))
     peaks, properties = find_peaks(
-        signal,
-        height=threshold,
-        prominence=rel_prominence * largest,
-        distance=max(1.0, fwhm),
+        signal, height=threshold, prominence=rel_prominence * largest, distance=max(1.0, fwhm)
     )
     if peaks.size == 0:
         return []
@@ -270,7 +256,8 @@ def fit_pulse(
     baseline_N: float | None = None,
     noise_N: float | None = None,
 ) -> PulseFit:
-    """Amplitude, arrival time and width of the largest pulse of a signal.
+    """Amplitude, arrival time and width of the largest pulse of a signal, ``ok=False``
+    with a reason when it cannot be measured.
 
     Pass one segment of :func:`find_pulses` (``time_s[seg.slice]``...) to measure a
     pulse that has neighbours, with the baseline of the whole signal.
@@ -286,11 +273,6 @@ def fit_pulse(
     baseline_N, noise_N : float, optional
         Baseline offset and noise standard deviation, N; estimated from the signal by
         :func:`estimate_baseline` when not given.
-
-    Returns
-    -------
-    PulseFit
-        ``ok=False`` with a reason when the pulse cannot be measured.
     """
     if estimator not in ESTIMATORS:
         raise ParameterError(f"estimator must be one of {ESTIMATORS}, got {estimator!r}")
@@ -306,28 +288,10 @@ def measure_pulse(
     baseline_N: float | None = None,
     noise_N: float | None = None,
 ) -> dict[str, PulseFit]:
-    """The largest pulse of a signal measured with each of several estimators.
-
-    What :func:`fit_pulse` gives for each estimator, with the checks, the baseline and
-    the width at half maximum (the initial tau) found once for all of them.
-
-    Parameters
-    ----------
-    time_s : array
-        Times, s, increasing and evenly sampled.
-    force_N : array
-        Signal, N.
-    estimators : sequence of str
-        Names from :data:`ESTIMATORS`.
-    baseline_N, noise_N : float, optional
-        Baseline offset and noise standard deviation, N; estimated from the signal by
-        :func:`estimate_baseline` when not given.
-
-    Returns
-    -------
-    dict of str to PulseFit
-        One fit per estimator; ``ok=False`` with a reason where it cannot be measured.
-    """
+    """The largest pulse of a signal measured with each of several ``estimators``
+    (names from :data:`ESTIMATORS`): what :func:`fit_pulse`, whose other parameters it
+    takes (s, N), gives for each, with the checks, the baseline and the width at half
+    maximum (the initial tau) found once for all. Returns {estimator: PulseFit}."""
     unknown = [e for e in estimators if e not in ESTIMATORS]
     if unknown:
         raise ParameterError(f"estimators must be among {ESTIMATORS}, got {unknown}")
@@ -340,10 +304,7 @@ def measure_pulse(
         return failed(f"fewer than {MIN_FIT_SAMPLES} samples")
     if not (np.all(np.isfinite(time)) and np.all(np.isfinite(force))):
         return failed("non-finite samples")
-    if baseline_N is None or noise_N is None:
-        estimated = estimate_baseline(time, force)
-        baseline_N = estimated[0] if baseline_N is None else baseline_N
-        noise_N = estimated[1] if noise_N is None else noise_N
+    baseline_N, noise_N = _baseline(time, force, baseline_N, noise_N)
     signal = force - baseline_N
     peak = int(np.argmax(signal))
     if not signal[peak] > 0:
@@ -361,6 +322,15 @@ def measure_pulse(
     }
 
 
+def _baseline(time, force, baseline_N, noise_N) -> tuple[float, float]:
+    """(baseline, noise), N: those given, or :func:`estimate_baseline`'s where None."""
+    if baseline_N is None or noise_N is None:
+        estimated = estimate_baseline(time, force)
+        baseline_N = estimated[0] if baseline_N is None else baseline_N
+        noise_N = estimated[1] if noise_N is None else noise_N
+    return baseline_N, noise_N
+
+
 def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
     time = np.asarray(time_s, dtype=float)
     force = np.asarray(force_N, dtype=float)
@@ -376,7 +346,7 @@ def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
 
 def _half_width_samples(signal: np.ndarray, peak: int) -> float:
     # Full width at half maximum, in samples, interpolated between samples.
-    from scipy.signal import peak_widths  # imported here: see find_pulses
+    from scipy.signal import peak_widths  # imported here: see chain.analysis.smoothing
 
     return float(peak_widths(signal, [peak], rel_height=0.5)[0][0])
 
@@ -396,7 +366,7 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
     errors (the window no longer moves the estimate beyond the noise), and the fit on
     the most samples is returned.
     """
-    from scipy.optimize import OptimizeWarning, curve_fit  # imported here: see find_pulses
+    from scipy.optimize import OptimizeWarning, curve_fit  # see chain.analysis.smoothing
 
     params = np.array([signal[peak], time[peak], tau0])
     windows = [_window(time, params[1], params[2], rising_only)]
@@ -446,14 +416,10 @@ def _iterated_fit(time, signal, peak, tau0, *, rising_only: bool) -> PulseFit:
 
 
 def _peak_estimate(time, signal, peak, tau0, noise, dt) -> PulseFit:
-    """Vertex of the least-squares parabola through the samples around the maximum.
-
-    ``peak`` is the largest sample, ``tau0`` tau from its width at half maximum (s), also
-    the value returned; ``dt`` the sampling interval, s.
-    """
-    # A parabola over tau/2 (quadratic Savitzky-Golay coefficients) averages the noise
-    # over the top of the pulse, where cos^6 is still a parabola to 0.2 %; when the
-    # pulse spans few samples this is the 3-point parabolic interpolation.
+    """Vertex of the least-squares parabola (quadratic Savitzky-Golay) through the
+    samples within tau/4 of the maximum (see the module docstring). ``peak`` is the
+    largest sample, ``tau0`` tau from its width at half maximum (s), also the value
+    returned; ``dt`` the sampling interval, s."""
     length = max(round(0.5 * tau0 / dt) | 1, 3)
     half = length // 2
     lo, hi = max(peak - half, half), min(peak + half + 1, len(signal) - half)

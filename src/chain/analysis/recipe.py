@@ -38,7 +38,7 @@ def fit_delays(delays: pd.DataFrame) -> pd.DataFrame:
 
 def fit_pulses(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> pd.DataFrame:
     """Pulses -> delays -> fits: :func:`chain.analysis.delays.delay_table` of the
-    selected collision shots, then :func:`fit_delays`.
+    selected collision shots, then :func:`fit_delays` (whose rows it returns).
 
     Parameters
     ----------
@@ -48,10 +48,5 @@ def fit_pulses(pulses: pd.DataFrame, selection: pd.DataFrame | None = None) -> p
     selection : DataFrame or None
         The acceptance protocol's shot selection
         (:func:`chain.analysis.selection.select_shots`); None keeps every shot.
-
-    Returns
-    -------
-    DataFrame
-        As :func:`fit_delays`.
     """
     return fit_delays(delay_table(pulses, selection=selection))

@@ -14,8 +14,7 @@ the true errors and var(C) = 1 / sum(w g^2).
 
 The free power law is fitted in log-log (default): ln y = ln A + p ln x by
 :func:`line_fit` (the arithmetic of :func:`scipy.stats.linregress`, whose import costs
-a job a second; weighted least squares by ``numpy.polyfit`` when sigma is given, with
-sigma_ln y = sigma / y), right for a relative scatter; or with
+a job a second), right for a relative scatter; or with
 ``method="nonlinear"`` by ``scipy.optimize.curve_fit`` of A x^p on y itself, right for a
 constant absolute scatter. Both give the standard error of p from the residuals.
 
@@ -93,7 +92,8 @@ class PowerLawFit:
 def fit_fixed_exponent(
     x, y, exponent: float = -1.0 / 6.0, sigma=None, *, absolute_sigma: bool = False
 ) -> CoefficientFit:
-    """Least-squares C of y = C x^exponent with its standard error.
+    """Least-squares C of y = C x^exponent with its standard error (NaN with fewer
+    than 2 points).
 
     Parameters
     ----------
@@ -108,11 +108,6 @@ def fit_fixed_exponent(
     absolute_sigma : bool
         Take ``sigma`` as absolute (True) or only relative (False, the error is then
         scaled by the reduced chi-square).
-
-    Returns
-    -------
-    CoefficientFit
-        NaN coefficient and error with fewer than 2 points.
     """
     x, y, weight = _points(x, y, sigma)
     n = x.size
@@ -120,24 +115,10 @@ def fit_fixed_exponent(
         return CoefficientFit(math.nan, math.nan, float(exponent), n, math.nan)
     if np.any(x <= 0):
         raise ParameterError("x must be > 0 for a power law")
-    basis = x**exponent
-    normal = float(np.sum(weight * basis**2))
-    coefficient = float(np.sum(weight * basis * y)) / normal
-    residual = y - coefficient * basis
-    if sigma is not None and absolute_sigma:
-        variance = 1.0 / normal
-    else:
-        variance = float(np.sum(weight * residual**2)) / (n - 1) / normal
-    return CoefficientFit(
-        coefficient,
-        math.sqrt(variance),
-        float(exponent),
-        n,
-        float(np.sqrt(np.mean(residual**2))),
-    )
+    return _coefficient_fit(x**exponent, y, weight, exponent, sigma is not None and absolute_sigma)
 
 
-def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> CoefficientFit:
+def fit_proportional(x, y, sigma=None) -> CoefficientFit:
     """Least-squares slope of y = slope x (through the origin) with its standard error.
 
     Parameters
@@ -145,44 +126,44 @@ def fit_proportional(x, y, sigma=None, *, absolute_sigma: bool = False) -> Coeff
     x, y : array
         Abscissae and ordinates (e.g. F_m and the SSW amplitude, both in N).
     sigma : array, optional
-        Standard errors of y; None for unweighted least squares.
-    absolute_sigma : bool
-        As in :func:`fit_fixed_exponent`.
+        Standard errors of y, relative (the error is scaled by the reduced chi-square);
+        None for unweighted least squares.
     """
     x, y, weight = _points(x, y, sigma)
     n = x.size
     if n < MIN_POINTS_ONE_PARAMETER:
         return CoefficientFit(math.nan, math.nan, 1.0, n, math.nan)
-    normal = float(np.sum(weight * x**2))
-    slope = float(np.sum(weight * x * y)) / normal
-    residual = y - slope * x
-    if sigma is not None and absolute_sigma:
+    return _coefficient_fit(x, y, weight, 1.0, absolute=False)
+
+
+def _coefficient_fit(basis, y, weight, exponent: float, absolute: bool) -> CoefficientFit:
+    """The weighted least-squares C of y = C basis, its error (from the weights alone
+    when ``absolute``, else scaled by the reduced chi-square: module docstring)."""
+    normal = float(np.sum(weight * basis**2))
+    coefficient = float(np.sum(weight * basis * y)) / normal
+    residual = y - coefficient * basis
+    if absolute:
         variance = 1.0 / normal
     else:
-        variance = float(np.sum(weight * residual**2)) / (n - 1) / normal
-    return CoefficientFit(slope, math.sqrt(variance), 1.0, n, float(np.sqrt(np.mean(residual**2))))
+        variance = float(np.sum(weight * residual**2)) / (basis.size - 1) / normal
+    rms = float(np.sqrt(np.mean(residual**2)))
+    return CoefficientFit(coefficient, math.sqrt(variance), float(exponent), basis.size, rms)
 
 
-def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
-    """Least-squares y = A x^p with A and p free, and their standard errors.
+def fit_power_law(x, y, *, method: str = "loglog") -> PowerLawFit:
+    """Unweighted least-squares y = A x^p with A and p free, and their standard errors
+    (NaN with fewer than 3 points).
 
     Parameters
     ----------
     x, y : array
         Abscissae and ordinates, both > 0 (use |Delta| for delays).
-    sigma : array, optional
-        Standard errors of y; None for unweighted least squares.
     method : {"loglog", "nonlinear"}
         Straight line in ln y vs ln x, or nonlinear fit of y (module docstring).
-
-    Returns
-    -------
-    PowerLawFit
-        NaN values with fewer than 3 points.
     """
     if method not in POWER_LAW_METHODS:
         raise ParameterError(f"method must be one of {POWER_LAW_METHODS}, got {method!r}")
-    x, y, weight = _points(x, y, sigma)
+    x, y, _ = _points(x, y, None)
     n = x.size
     if n < MIN_POINTS_TWO_PARAMETERS:
         return PowerLawFit(math.nan, math.nan, math.nan, math.nan, n, method)
@@ -190,16 +171,7 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
         raise ParameterError("x and y must be > 0 for a power-law fit")
     log_x, log_y = np.log(x), np.log(y)
     if method == "loglog":
-        if sigma is None:
-            exponent, log_a, exponent_error, log_a_error = line_fit(log_x, log_y)
-        else:
-            # sigma of ln y is sigma / y; polyfit weights multiply the residuals.
-            log_weight = y * np.sqrt(weight)
-            coefficients, covariance = np.polyfit(log_x, log_y, 1, w=log_weight, cov="unscaled")
-            residual = log_weight * (log_y - np.polyval(coefficients, log_x))
-            covariance = covariance * float(np.sum(residual**2)) / (n - 2)
-            exponent, log_a = coefficients
-            exponent_error, log_a_error = np.sqrt(np.diag(covariance))
+        exponent, log_a, exponent_error, log_a_error = line_fit(log_x, log_y)
         prefactor = math.exp(log_a)
         return PowerLawFit(
             prefactor,
@@ -213,11 +185,7 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
 
     start = fit_power_law(x, y, method="loglog")
     params, covariance = curve_fit(
-        lambda u, a, p: a * u**p,
-        x,
-        y,
-        p0=(start.prefactor, start.exponent),
-        sigma=None if sigma is None else 1.0 / np.sqrt(weight),
+        lambda u, a, p: a * u**p, x, y, p0=(start.prefactor, start.exponent)
     )
     errors = np.sqrt(np.diag(covariance))
     return PowerLawFit(
@@ -226,7 +194,8 @@ def fit_power_law(x, y, sigma=None, *, method: str = "loglog") -> PowerLawFit:
 
 
 def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
-    """Unweighted least-squares line y = slope x + intercept, and standard errors.
+    """Unweighted least-squares line y = slope x + intercept: (slope, intercept, stderr
+    of the slope, stderr of the intercept).
 
     The arithmetic of :func:`scipy.stats.linregress` (scipy 1.17), operation for
     operation, so that the numbers are the same to the last bit (a test compares them),
@@ -236,11 +205,6 @@ def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
     ----------
     x, y : array
         At least 3 points, x not all equal; units of y per unit of x for the slope.
-
-    Returns
-    -------
-    tuple of float
-        slope, intercept, stderr of the slope, stderr of the intercept.
     """
     if np.amax(x) == np.amin(x):
         raise ParameterError("cannot fit a line if all x values are identical")

@@ -42,9 +42,6 @@ def usable_rows(
     """The rows fit to draw or fit: ``ok`` True and finite (and > 0 if ``positive``) in
     ``columns``; how many were left out, and why, goes to the log (INFO).
 
-    A flagged row (``ok`` False, with its ``reason``) or a NaN never passes quietly into
-    a figure or a fit.
-
     Parameters
     ----------
     table : DataFrame
@@ -108,7 +105,8 @@ def flag_unusable(
 
 
 def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict:
-    """Rows and flagged rows of a results table, per source.
+    """Rows and flagged rows of a results table, per source: ``{source: {"rows": n,
+    "flagged": n_ok_false, "nan": n_ok_but_nan}}``.
 
     Parameters
     ----------
@@ -116,11 +114,6 @@ def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict
         A table with ``source`` and ``ok`` columns.
     columns : iterable of str
         Value columns: an ``ok`` row with a NaN there counts as ``nan``.
-
-    Returns
-    -------
-    dict
-        ``{source: {"rows": n, "flagged": n_ok_false, "nan": n_ok_but_nan}}``.
     """
     if table is None or not len(table):
         return {}
@@ -140,33 +133,17 @@ def flag_counts(table: pd.DataFrame | None, columns: Iterable[str] = ()) -> dict
 
 
 def of_estimator(table: pd.DataFrame, estimator: str) -> pd.DataFrame:
-    """The rows of ``table`` made with pulse estimator ``estimator``, in their order.
-
-    A study's job fits every estimator of the run (the rows say which in their
-    ``estimator`` column), so that a what-if that only picks another main estimator
-    reuses the job; the table that reports the study takes the main one's rows here.
-
-    Parameters
-    ----------
-    table : DataFrame
-        Rows with an ``estimator`` column (:data:`chain.analysis.pulses.ESTIMATORS`).
-    estimator : str
-        The estimator whose rows are kept.
-
-    Returns
-    -------
-    DataFrame
-        Those rows, indexed 0..n-1.
-    """
+    """The rows of ``table`` (with an ``estimator`` column) made with pulse estimator
+    ``estimator`` (:data:`chain.analysis.pulses.ESTIMATORS`), in their order, indexed
+    0..n-1: a study's job fits every estimator of the run, so that a what-if that only
+    picks another main estimator reuses the job, and its report takes the main one's."""
     return _tagged(table, "estimator", estimator)
 
 
 def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
-    """The rows of ``table`` whose ``column`` is ``value``, without that column.
-
-    A study whose report depends on the run's main estimator computes its table for
-    every estimator, tagged in ``column``; the reporting job picks the main one's rows
-    here, so that the table is the one the study would have written for it alone.
+    """The rows of ``table`` whose ``column`` is ``value``, in their order, indexed
+    0..n-1, without that column: the table a study tagged per estimator would have
+    written for that one alone.
 
     Parameters
     ----------
@@ -176,11 +153,6 @@ def picked(table: pd.DataFrame, column: str, value: str) -> pd.DataFrame:
         The tag column (e.g. ``estimator``, ``main_estimator``).
     value : str
         The tag of the rows kept.
-
-    Returns
-    -------
-    DataFrame
-        Those rows in their order, indexed 0..n-1, ``column`` dropped.
     """
     return _tagged(table, column, value).drop(columns=column)
 

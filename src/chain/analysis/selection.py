@@ -24,41 +24,18 @@ import pandas as pd
 from chain.analysis.rows import is_ok
 from chain.errors import ParameterError
 from chain.labels import SKIPPED_REASON
+from chain.traces import SHOT_COLUMNS
 
 #: The paper's amplitude-match tolerance (5 %).
 DEFAULT_TOLERANCE = 0.05
 
 #: Columns of the selection table, in order.
-SELECTION_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "F_left_N",
-    "F_right_N",
-    "mismatch",
-    "kept",
-    "reason",
-)
+SELECTION_COLUMNS = (*SHOT_COLUMNS, "F_left_N", "F_right_N", "mismatch", "kept", "reason")
 
 #: Columns naming a series: the shot key is these plus ``shot``.
 GROUP = ["source", "model", "N"]
 _KEY = [*GROUP, "shot"]
-_PULSE_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "kind",
-    "amplitude",
-    "sensor",
-    "role",
-    "estimator",
-    "F_m_N",
-    "ok",
-)
+_PULSE_COLUMNS = (*SHOT_COLUMNS, "sensor", "role", "estimator", "F_m_N", "ok")
 
 
 def amplitude_mismatch(force_left_N, force_right_N):
@@ -141,7 +118,7 @@ def select_shots(
                     **dict(zip(_KEY, key)),
                     "kind": record.kind,
                     "amplitude": int(record.amplitude),
-                    **_rejected("no pulse detected (no pulse rows for this shot)"),
+                    **_verdict("no pulse detected (no pulse rows for this shot)"),
                 }
             )
     selection = pd.DataFrame(rows, columns=SELECTION_COLUMNS)
@@ -149,12 +126,12 @@ def select_shots(
     return selection.sort_values(_KEY, kind="stable").reset_index(drop=True)
 
 
-def _rejected(reason: str, left=math.nan, right=math.nan, mismatch=math.nan) -> dict:
+def _verdict(reason: str, left=math.nan, right=math.nan, mismatch=math.nan, kept=False) -> dict:
     return {
         "F_left_N": left,
         "F_right_N": right,
         "mismatch": mismatch,
-        "kept": False,
+        "kept": kept,
         "reason": reason,
     }
 
@@ -194,19 +171,13 @@ def _judge_collision(pulses: dict[tuple, dict], tolerance: float) -> dict:
     right, why_right = _pulse(pulses, "S2", "incident")
     if left is None or right is None:
         why = "; ".join(w for w in (why_left, why_right) if w)
-        return _rejected(why, left if left else math.nan, right if right else math.nan)
+        return _verdict(why, left if left else math.nan, right if right else math.nan)
     mismatch = float(amplitude_mismatch(left, right))
     # A hair of slack so that a mismatch equal to the tolerance is not lost to rounding.
     kept = mismatch <= tolerance * (1 + 1e-12)
     relation = "<=" if kept else ">"
     reason = f"amplitude mismatch {100 * mismatch:.1f}% {relation} {100 * tolerance:g}%"
-    return {
-        "F_left_N": left,
-        "F_right_N": right,
-        "mismatch": mismatch,
-        "kept": kept,
-        "reason": ("kept: " if kept else "") + reason,
-    }
+    return _verdict(("kept: " if kept else "") + reason, left, right, mismatch, kept)
 
 
 def _judge_reference(pulses: dict[tuple, dict]) -> dict:
@@ -220,14 +191,8 @@ def _judge_reference(pulses: dict[tuple, dict]) -> dict:
             problems.append(why)
     left = forces.get("S1") or math.nan
     if problems:
-        return _rejected("; ".join(problems), left)
-    return {
-        "F_left_N": left,
-        "F_right_N": math.nan,
-        "mismatch": math.nan,
-        "kept": True,
-        "reason": "kept: reference pulse fitted at " + " and ".join(sensors),
-    }
+        return _verdict("; ".join(problems), left)
+    return _verdict("kept: reference pulse fitted at " + " and ".join(sensors), left, kept=True)
 
 
 def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.DataFrame:
@@ -258,17 +223,13 @@ def apply_selection(table: pd.DataFrame, selection: pd.DataFrame | None) -> pd.D
 
 
 def selection_counts(selection: pd.DataFrame | None) -> list[dict]:
-    """Kept and rejected shots of the acceptance protocol per series, chain and kind.
+    """Kept and rejected shots of the acceptance protocol per series, chain and kind:
+    ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
 
     Parameters
     ----------
     selection : DataFrame or None
         ``experiment/selection.csv`` (:func:`chain.analysis.selection.select_shots`).
-
-    Returns
-    -------
-    list of dict
-        ``{"model", "N", "kind", "kept", "rejected"}`` sorted by model, N, kind.
     """
     if selection is None or not len(selection):
         return []

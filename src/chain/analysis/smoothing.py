@@ -37,13 +37,8 @@ def savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
 
 @lru_cache(maxsize=64)
 def smoothing_coefficients(length: int) -> np.ndarray:
-    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only).
-
-    Parameters
-    ----------
-    length : int
-        Odd window length, samples.
-    """
+    """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only), for an
+    odd window ``length`` in samples."""
     from scipy.signal import savgol_coeffs
 
     coefficients = savgol_coeffs(length, 2)
@@ -53,14 +48,8 @@ def smoothing_coefficients(length: int) -> np.ndarray:
 
 @lru_cache(maxsize=64)
 def noise_gain(length: int) -> float:
-    """Standard deviation of ``savgol_filter(x, length, 2)`` on white noise of unit
-    standard deviation (the root sum of squares of its coefficients).
-
-    Parameters
-    ----------
-    length : int
-        Odd window length, samples.
-    """
+    """Standard deviation of ``savgol_filter(x, length, 2)`` (odd ``length``, samples) on
+    white noise of unit standard deviation (the root sum of squares of its coefficients)."""
     return math.sqrt(float(np.sum(smoothing_coefficients(length) ** 2)))
 
 
@@ -89,8 +78,9 @@ def smoothed_interior(signal: np.ndarray, length: int, lo: int, hi: int) -> np.n
 
 
 def smoother(time_s, tau_s: float, lo: int, hi: int):
-    """Quadratic Savitzky-Golay smoothing tau/2 long that is right on samples [lo, hi),
-    and its :func:`noise_gain`.
+    """Quadratic Savitzky-Golay smoothing tau/2 long that is right on samples [lo, hi):
+    (a function of an array of ``len(time_s)`` values that returns it smoothed, its
+    :func:`noise_gain`).
 
     Where no window of [lo, hi) reaches the record's ends, only those samples are
     smoothed (:func:`smoothed_interior`: the filter's own values, bit for bit) and the
@@ -105,13 +95,6 @@ def smoother(time_s, tau_s: float, lo: int, hi: int):
         Pulse time scale, s.
     lo, hi : int
         The samples that will be read, [lo, hi).
-
-    Returns
-    -------
-    smooth : callable
-        Array of ``len(time_s)`` values -> the smoothed array, same unit.
-    gain : float
-        Noise gain of the smoothing.
     """
     from scipy.signal import savgol_filter
 

@@ -80,34 +80,11 @@ MIN_PEAK_SNR = 8.0
 SSW_METHODS = ("residual", "peak")
 
 #: Columns of :func:`ssw_table` (after ``reason``: extras).
-SSW_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "amplitude",
-    "sensor",
-    "bead",
-    "wave",
-    "F_m_N",
-    "ssw_N",
-    "ssw_time_us",
-    "method",
-    "ok",
-    "reason",
-    "ssw_lag_us",
-    "F_crossed_N",
-    "reference_shot",
-    "template_scale",
-    "template_misfit_N",
-    "ssw_floor_N",
-    "trailing_min_us",
-    "ssw_candidate_N",
-    "ssw_sys_N",
-    "ssw_stat_N",
-    "ssw_err_N",
-    "resolved",
-    "upper_limit",
+SSW_COLUMNS = tuple(
+    "source model N shot amplitude sensor bead wave F_m_N ssw_N ssw_time_us method ok "
+    "reason ssw_lag_us F_crossed_N reference_shot template_scale template_misfit_N "
+    "ssw_floor_N trailing_min_us ssw_candidate_N ssw_sys_N ssw_stat_N ssw_err_N resolved "
+    "upper_limit".split()
 )
 
 
@@ -368,16 +345,7 @@ def _sensor_rows(shot, sensor: str, context: dict) -> list[dict]:
     where = (shot.source, shot.model, shot.N, shot.shot)
     crossed = context["lookup"].get((*where, sensor, "crossed"))
     incident = context["lookup"].get((*where, first, "incident"))
-    base = {
-        "source": shot.source,
-        "model": shot.model,
-        "N": shot.N,
-        "shot": shot.shot,
-        "amplitude": shot.amplitude,
-        "sensor": sensor,
-        "bead": context["bead_of"][sensor],
-        "wave": wave,
-    }
+    base = {**shot._asdict(), "sensor": sensor, "bead": context["bead_of"][sensor], "wave": wave}
     same = context["references_of"].get(tuple(getattr(shot, key) for key in _REFERENCE_KEY))
     reason = ""
     if crossed is None or not bool(crossed.ok):

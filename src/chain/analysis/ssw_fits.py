@@ -1,7 +1,6 @@
 """SSW fits: SSW = slope x F_m per series and chain with a statistical and a systematic
 error, whether the SSW is resolved at each sensor, and the even / odd ratio of the
-slopes. Reads ``ssw.csv`` rows (:func:`chain.analysis.ssw.ssw_table`); computes no SSW.
-"""
+slopes. Reads ``ssw.csv`` rows (:func:`chain.analysis.ssw.ssw_table`); computes no SSW."""
 
 from __future__ import annotations
 
@@ -14,17 +13,8 @@ from chain.analysis.regression import fit_proportional, ratio_with_error
 from chain.analysis.rows import is_ok
 
 #: Columns of :func:`ssw_fit_table`.
-SSW_FIT_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "slope",
-    "slope_stderr",
-    "slope_stat",
-    "slope_sys",
-    "n_points",
-    "n_resolved",
-    "method",
+SSW_FIT_COLUMNS = tuple(
+    "source model N slope slope_stderr slope_stat slope_sys n_points n_resolved method".split()
 )
 
 

@@ -16,27 +16,10 @@ from chain.analysis.regression import ratio_with_error
 from chain.analysis.ssw_track import MIN_SPEED_CONTACTS
 
 #: Columns of :func:`ssw_speed_table` (after ``first_separated_contact``: extras).
-SPEED_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "wave",
-    "speed_m_s",
-    "eq5_speed_m_s",
-    "ratio",
-    "first_separated_contact",
-    "distance_beads",
-    "first_detached_contact",
-    "force_N",
-    "F_m_N",
-    "n_contacts",
-    "shot",
-    "n_shots",
-    "n_shots_separated",
-    "ratio_min",
-    "ratio_max",
-    "ssw_over_Fm",
-    "ssw_over_Fm_err",
+SPEED_COLUMNS = tuple(
+    "source model N wave speed_m_s eq5_speed_m_s ratio first_separated_contact "
+    "distance_beads first_detached_contact force_N F_m_N n_contacts shot n_shots "
+    "n_shots_separated ratio_min ratio_max ssw_over_Fm ssw_over_Fm_err".split()
 )
 
 
@@ -179,15 +162,9 @@ def _far_field(shots: list[dict]) -> dict:
 
 
 #: Columns of :func:`separation_table` (summary key ``ssw_separation``).
-SEPARATION_COLUMNS = (
-    "model",
-    "N",
-    "wave",
-    "first_separated_contact",
-    "distance_beads",
-    "speed_ratio",
-    "n_shots_separated",
-    "n_shots",
+SEPARATION_COLUMNS = tuple(
+    "model N wave first_separated_contact distance_beads speed_ratio n_shots_separated "
+    "n_shots".split()
 )
 
 
@@ -213,17 +190,8 @@ def separation_table(speed: pd.DataFrame) -> pd.DataFrame:
 
 
 #: Columns of :func:`far_field_parity` (summary key ``ssw_far_field``).
-FAR_FIELD_COLUMNS = (
-    "source",
-    "model",
-    "even_N",
-    "odd_N",
-    "even",
-    "even_err",
-    "odd",
-    "odd_err",
-    "ratio",
-    "ratio_err",
+FAR_FIELD_COLUMNS = tuple(
+    "source model even_N odd_N even even_err odd odd_err ratio ratio_err".split()
 )
 
 

@@ -64,26 +64,10 @@ MIN_RUN = 3
 #: Fewest separated contacts for a speed fit (two intervals).
 MIN_SPEED_CONTACTS = 3
 
-WAVES = ("LSTW", "RSTW")
-
 #: Columns of :func:`ssw_track_table` (after ``separated``: extras).
-TRACK_COLUMNS = (
-    "source",
-    "model",
-    "N",
-    "shot",
-    "wave",
-    "contact",
-    "time_us",
-    "force_N",
-    "F_m_N",
-    "separated",
-    "detached",
-    "trailing_min_N",
-    "distance_beads",
-    "main_time_us",
-    "main_force_N",
-    "other_time_us",
+TRACK_COLUMNS = tuple(
+    "source model N shot wave contact time_us force_N F_m_N separated detached "
+    "trailing_min_N distance_beads main_time_us main_force_N other_time_us".split()
 )
 
 
@@ -189,9 +173,8 @@ def _first_bump(signal, main_index: int, window_s: float, floor_N: float, time) 
     ``floor_N``) within ``window_s`` of it, or -1.
 
     The first peak ``scipy.signal.find_peaks(signal[main_index:], height=floor_N,
-    prominence=floor_N)`` returns, found without scipy.signal, whose import (1.1 s with
-    scipy 1.17, which parses every function's docstring and loads scipy.stats) was
-    most of an ssw_track job's start-up; ``tests/test_ssw_track.py`` compares the two."""
+    prominence=floor_N)`` returns, found without importing scipy.signal (a second, most
+    of an ssw_track job's start-up); ``tests/test_ssw_track.py`` compares the two."""
     if not np.isfinite(window_s):
         return -1
     segment = np.asarray(signal[main_index:], dtype=float)
@@ -274,16 +257,8 @@ def track_collision(time_s, contact_force_N, *, floor: float = TRACK_FLOOR) -> d
     return {"LSTW": left, "RSTW": right}
 
 
-def ssw_track_table(
-    time_s,
-    contact_force_N,
-    *,
-    source: str,
-    model: str,
-    shots=None,
-    floor: float = TRACK_FLOOR,
-) -> pd.DataFrame:
-    """The rows of ``ssw_track.csv`` for a batch of collisions of one chain.
+def ssw_track_table(time_s, contact_force_N, *, source: str, model: str) -> pd.DataFrame:
+    """The rows of ``ssw_track.csv`` for a batch of collisions of one chain, shots 0..B-1.
 
     Parameters
     ----------
@@ -293,10 +268,6 @@ def ssw_track_table(
         Contact forces of B collision shots, N (``SimulationResult.contact_force``).
     source, model : str
         Values of the ``source`` and ``model`` columns.
-    shots : sequence of int, optional
-        Shot id of each collision (default 0..B-1).
-    floor : float
-        Least SSW height and prominence as a fraction of F_m.
 
     Returns
     -------
@@ -310,11 +281,10 @@ def ssw_track_table(
         raise ParameterError(
             f"contact_force_N must be (shots, samples, contacts), got {force.shape}"
         )
-    shots = np.arange(force.shape[0]) if shots is None else np.asarray(shots)
     frames = []
-    for shot, forces in zip(shots, force):
-        for wave, found in track_collision(time_s, forces, floor=floor).items():
-            frames.append(_track_rows(found, source, model, forces.shape[1] + 1, int(shot), wave))
+    for shot, forces in enumerate(force):
+        for wave, found in track_collision(time_s, forces).items():
+            frames.append(_track_rows(found, source, model, forces.shape[1] + 1, shot, wave))
     return pd.concat(frames, ignore_index=True)[list(TRACK_COLUMNS)]
 
 

@@ -10,12 +10,8 @@ from chain._lazy import lazy_exports
 __getattr__, __dir__, __all__ = lazy_exports(
     __name__,
     {
-        "simulate_shots": "chain.apparatus.shots",
-        "trace_table": "chain.apparatus.shots",
-        "VirtualExperiment": "chain.apparatus.virtual",
-        "run_virtual_experiment": "chain.apparatus.virtual",
-        "MeasuredDataError": "chain.apparatus.measured",
-        "load_dataset": "chain.apparatus.measured",
-        "read_metadata": "chain.apparatus.measured",
+        "chain.apparatus.shots": "simulate_shots trace_table",
+        "chain.apparatus.virtual": "VirtualExperiment run_virtual_experiment",
+        "chain.apparatus.measured": "MeasuredDataError load_dataset read_metadata",
     },
 )

@@ -85,7 +85,8 @@ def sampling_instants(start_s: float, stop_s: float, interval_s: float, phase_s:
 
 
 def resample(time_s, signal, interval_s: float, phase_s: float = 0.0):
-    """Sample a finely recorded signal every ``interval_s`` by linear interpolation.
+    """Sample a finely recorded signal every ``interval_s`` by linear interpolation:
+    (sampling instants (K,) s, the signal at those instants (..., K)).
 
     The source must be recorded much finer than ``interval_s`` (a few points per
     interval) for linear interpolation to stand for the continuous signal.
@@ -100,13 +101,6 @@ def resample(time_s, signal, interval_s: float, phase_s: float = 0.0):
         Sampling interval, s.
     phase_s : float
         Time of the first sample after ``time_s[0]``, s, in [0, interval_s).
-
-    Returns
-    -------
-    instants : array (K,)
-        Sampling instants, s.
-    samples : array (..., K)
-        The signal at those instants.
     """
     time = np.asarray(time_s, dtype=float)
     values = np.asarray(signal, dtype=float)
@@ -203,7 +197,8 @@ def digitise(
     phase_s: float = 0.0,
     rng: np.random.Generator | None = None,
 ):
-    """What the digitiser records from a sensor seeing ``force_N``: sampled volts.
+    """What the digitiser records from a sensor seeing ``force_N``: (sampling instants
+    (K,) s, recorded voltages (..., K) V).
 
     Parameters
     ----------
@@ -225,13 +220,6 @@ def digitise(
         First sample time after ``time_s[0]``, s, in [0, sampling_interval_s).
     rng : numpy.random.Generator, optional
         Needed when ``noise_N`` > 0.
-
-    Returns
-    -------
-    instants : array (K,)
-        Sampling instants, s.
-    volts : array (..., K)
-        Recorded voltages, V.
     """
     instants, force = resample(time_s, force_N, sampling_interval_s, phase_s)
     if require_nonnegative("noise_N", noise_N) > 0:

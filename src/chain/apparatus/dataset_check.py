@@ -122,7 +122,8 @@ def check_dataset(
     limit: int = MAX_PROBLEMS,
     keep_data: bool = False,
 ) -> DatasetCheck:
-    """Check a measured dataset: its metadata and every shot file it lists.
+    """Check a measured dataset, its metadata and every shot file it lists: its problems
+    and channel faults (a :class:`DatasetCheck`, empty when it is good).
 
     Parameters
     ----------
@@ -136,11 +137,6 @@ def check_dataset(
         Stop after this many problems (the dataset is bad either way).
     keep_data : bool
         Keep the samples of the shot files parsed (``DatasetCheck.data``).
-
-    Returns
-    -------
-    DatasetCheck
-        Problems and channel faults of the dataset (empty when it is good).
 
     Raises
     ------

@@ -1,10 +1,8 @@
 """Shots run by LAMMPS (:mod:`chain.physics.lammps_engine`) as trace tables.
 
-The same protocol as :func:`chain.apparatus.shots.simulate_shots`: for each launch
-speed V0, a collision shot (+V0 on bead 1, -V0 on bead N) and a reference shot (+V0 on
-bead 1 alone), read out as the force felt at the sensor beads,
-(F_{n-1,n} + F_{n,n+1}) / 2, in the project's one trace format with source ``lammps``,
-so that the analysis of every other series (pulses, delays, C, SSW) runs on them.
+The same protocol as :func:`chain.apparatus.shots.simulate_shots`, read out as the
+force felt at the sensor beads in the trace format with source ``lammps``, so that the
+analysis of every other series (pulses, delays, C, SSW) runs on them.
 """
 
 from __future__ import annotations

@@ -9,7 +9,8 @@ the shots are::
         shot_0000.csv        t_s,bead9_V,bead17_V
         ...
 
-The format lives in four modules, one concept each, re-exported here:
+The format lives in four modules, one concept each (the names the pipeline and the
+virtual experiment use are re-exported here):
 
 * :mod:`chain.apparatus.measured_format`  names, tolerances, :class:`MeasuredDataError`;
 * :mod:`chain.apparatus.metadata`  ``metadata.yaml``, validated against the JSON schema
@@ -38,20 +39,10 @@ from chain.apparatus.measured_format import (
     MAX_PROBLEMS,
     METADATA_FILE,
     STANDARD_GRAVITY,
-    TIME_COLUMN,
-    TIME_STEP_TOLERANCE,
     MeasuredDataError,
     problem_list,
-    voltage_column,
 )
-from chain.apparatus.metadata import (
-    DatasetMetadata,
-    ShotEntry,
-    impact_speed_from_drop_height,
-    parse_metadata,
-    read_metadata,
-    write_metadata,
-)
+from chain.apparatus.metadata import DatasetMetadata, read_metadata, write_metadata
 from chain.apparatus.shot_files import read_shot_csv, write_shot_csv
 from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
@@ -165,23 +156,12 @@ def load_dataset(
 __all__ = [
     "BAD_CHANNEL_POLICIES",
     "FORMAT_NAME",
-    "MAX_PROBLEMS",
     "METADATA_FILE",
     "STANDARD_GRAVITY",
-    "TIME_COLUMN",
-    "TIME_STEP_TOLERANCE",
-    "DatasetCheck",
-    "DatasetMetadata",
     "MeasuredDataError",
-    "ShotEntry",
-    "check_dataset",
-    "impact_speed_from_drop_height",
     "load_dataset",
-    "parse_metadata",
     "read_metadata",
-    "read_shot_csv",
     "usable_shots",
-    "voltage_column",
     "write_metadata",
     "write_shot_csv",
 ]

@@ -1,6 +1,5 @@
 """Vocabulary of the measured-trace format (``data/README.md``): names, tolerances and
-the error type shared by the metadata reader, the shot-file reader and the dataset check.
-"""
+the error type shared by the metadata reader, the shot-file reader and the dataset check."""
 
 from __future__ import annotations
 

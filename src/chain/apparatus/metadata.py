@@ -333,17 +333,8 @@ def _typed(mapping: Mapping, messages: _Messages) -> DatasetMetadata:
 
 
 def read_metadata(folder: str | os.PathLike) -> DatasetMetadata:
-    """Read and check ``<folder>/metadata.yaml``.
-
-    Parameters
-    ----------
-    folder : path
-        Dataset folder.
-
-    Raises
-    ------
-    MeasuredDataError
-    """
+    """Read and check ``<folder>/metadata.yaml`` of a dataset folder
+    (:class:`MeasuredDataError` when it is missing or wrong)."""
     path = Path(folder) / METADATA_FILE
     if not Path(folder).is_dir():
         raise MeasuredDataError(f"{folder}: no such dataset folder")

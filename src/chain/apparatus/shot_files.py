@@ -134,7 +134,9 @@ def shot_file_problems(
     samples: int | None = None,
     limit: int = MAX_PROBLEMS,
 ) -> tuple[np.ndarray | None, list[str]]:
-    """Read one shot file and list everything wrong with it.
+    """Read one shot file and list everything wrong with it: (its samples, (S, 1 +
+    n_sensors), time s then volts V per row, or None when there are problems; the
+    problems, one line each: file, line, column, what was expected).
 
     Parameters
     ----------
@@ -151,13 +153,6 @@ def shot_file_problems(
     limit : int
         Stop listing after this many problems (plus one, so that callers know more
         were found).
-
-    Returns
-    -------
-    data : (S, 1 + n_sensors) array or None
-        Time (s) then volts (V) per row; None when there are problems.
-    problems : list of str
-        One line per problem: file, line, column, what was expected.
     """
     where = Path(path)
     try:
@@ -201,18 +196,8 @@ def read_shot_csv(
     sampling_interval_s: float | None = None,
     samples: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Read and check one shot file (rules: :func:`shot_file_problems`).
-
-    Returns
-    -------
-    time : (S,) s
-    volts : (n_sensors, S) V
-
-    Raises
-    ------
-    MeasuredDataError
-        Listing every problem, one line each, naming the file and the line.
-    """
+    """Read and check one shot file (rules: :func:`shot_file_problems`): (time (S,) s,
+    volts (n_sensors, S) V), or :class:`MeasuredDataError` listing every problem."""
     data, problems = shot_file_problems(path, sensor_beads, sampling_interval_s, samples)
     if problems:
         raise MeasuredDataError(problem_list(problems))

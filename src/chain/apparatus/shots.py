@@ -31,13 +31,12 @@ def trace_table(
     *,
     kind: str,
     model_name: str,
-    source: str = "simulation",
     readout: str = "felt",
     first_shot: int = 0,
-    amplitudes=None,
 ) -> pd.DataFrame:
     """The forces at ``beads`` of every launch of ``result`` as a trace table
-    (:mod:`chain.traces`), one shot per launch.
+    (:mod:`chain.traces`, source ``simulation``), one shot per launch, amplitude index
+    0..B-1.
 
     Parameters
     ----------
@@ -49,32 +48,25 @@ def trace_table(
         Shot kind written in the table.
     model_name : str
         Value of the ``model`` column.
-    source : str
-        Value of the ``source`` column.
     readout : {"felt", "sensor"}
         ``felt``: (F_{n-1,n} + F_{n,n+1}) / 2 (sensors not modelled); ``sensor``: the
         split-bead sensor reading (the beads must be sensor beads of the model).
     first_shot : int
         Shot id of the first launch; launches get consecutive ids.
-    amplitudes : sequence of int, optional
-        Amplitude index per launch (default 0..B-1).
     """
     if readout not in ("felt", "sensor"):
         raise ParameterError(f"readout must be 'felt' or 'sensor', got {readout!r}")
     read = result.force_felt if readout == "felt" else result.sensor
     columns = {sensor_column(b): read(b) for b in beads}
     batch, samples = result.contact_force.shape[:2]
-    amplitudes = np.arange(batch) if amplitudes is None else np.asarray(amplitudes)
-    if amplitudes.shape != (batch,):
-        raise ParameterError(f"amplitudes must have {batch} entries, got {amplitudes.shape}")
     table = pd.DataFrame(
         {
-            "source": source,
+            "source": "simulation",
             "model": model_name,
             "N": result.model.n_beads,
             "shot": np.repeat(np.arange(first_shot, first_shot + batch), samples),
             "kind": kind,
-            "amplitude": np.repeat(amplitudes, samples),
+            "amplitude": np.repeat(np.arange(batch), samples),
             "v0_left_m_s": np.repeat(result.v_left, samples),
             "v0_right_m_s": np.repeat(result.v_right, samples),
             "t_s": np.tile(result.time, batch),

@@ -29,7 +29,8 @@ TRUTH_FILE = "virtual_truth.csv"
 def run_virtual_experiment(
     settings: VirtualExperiment, out_folder: str | os.PathLike, dataset_name: str
 ) -> Path:
-    """Run the virtual experiment and write its shots as a measured dataset.
+    """Run the virtual experiment and write its shots as a measured dataset; returns
+    ``out_folder``.
 
     Writes, in ``out_folder``: one ``shot_XXXX.csv`` per shot, ``metadata.yaml`` (the
     measured-trace format of ``data/README.md``; nominal impact speeds or drop heights,
@@ -47,11 +48,6 @@ def run_virtual_experiment(
     dataset_name : str
         Dataset name written in the metadata (the ``model`` column after loading);
         use the same name for the chains of one experiment so their fits pool.
-
-    Returns
-    -------
-    Path
-        ``out_folder``.
     """
     if not isinstance(dataset_name, str) or not dataset_name.strip():
         raise ParameterError(f"dataset_name must be a non-empty string, got {dataset_name!r}")

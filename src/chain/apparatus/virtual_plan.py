@@ -34,15 +34,9 @@ def plan_shots(settings: VirtualExperiment) -> pd.DataFrame:
 
 
 def collision_speeds(settings: VirtualExperiment) -> tuple[np.ndarray, np.ndarray]:
-    """True impact speeds of the left and right strikers of the collision shots, m/s,
-    shape (amplitudes, collision shots): the plan's (:func:`plan_shots`), drawn alone
-    (they are its first draws), for a check that needs no more of it.
-
-    Parameters
-    ----------
-    settings : VirtualExperiment
-        The apparatus and the shot plan.
-    """
+    """True impact speeds of the left and right strikers of the collision shots of
+    ``settings``, m/s, shape (amplitudes, collision shots): the plan's (:func:`plan_shots`),
+    drawn alone (they are its first draws), for a check that needs no more of it."""
     shape = (settings.nominal_speeds.size, settings.collision_shots, 3)
     return _collision_speeds(settings, np.random.default_rng(settings.seed).standard_normal(shape))
 
@@ -82,30 +76,13 @@ def _plan(settings: VirtualExperiment, rng: np.random.Generator) -> pd.DataFrame
     rows = []
     for a in range(n_amp):
         for c in range(n_col):
-            rows.append(
-                (
-                    "collision",
-                    a,
-                    left[a, c],
-                    right[a, c],
-                    settings.right_delay_s + settings.timing_jitter_s * collision_draws[a, c, 2],
-                    collision_phase[a, c],
-                )
-            )
+            delay = settings.right_delay_s + settings.timing_jitter_s * collision_draws[a, c, 2]
+            rows.append(("collision", a, left[a, c], right[a, c], delay, collision_phase[a, c]))
         for r in range(n_ref):
-            rows.append(
-                (
-                    "reference",
-                    a,
-                    _speed(speeds[a], reference_draws[a, r], sigma_ref),
-                    0.0,
-                    0.0,
-                    reference_phase[a, r],
-                )
-            )
+            speed = _speed(speeds[a], reference_draws[a, r], sigma_ref)
+            rows.append(("reference", a, speed, 0.0, 0.0, reference_phase[a, r]))
     plan = pd.DataFrame(
-        rows,
-        columns=["kind", "amplitude", "v_left_m_s", "v_right_m_s", "delay_s", "phase"],
+        rows, columns=["kind", "amplitude", "v_left_m_s", "v_right_m_s", "delay_s", "phase"]
     )
     plan.insert(0, "shot", np.arange(len(plan)))
     plan.insert(1, "file", [f"shot_{s:04d}.csv" for s in plan["shot"]])

@@ -32,8 +32,8 @@ CHAIN_STREAM = 24
 #: Fields drawn once per chain (non-negative).
 _CHAIN_FIELDS = ("radius_dispersion", "gap_mean_m", "gap_spread_m")
 
-#: Field names of datasets written before the fields took the config's names (issue
-#: 31) -> today's names, so that :meth:`VirtualExperiment.from_dataset` reads them.
+#: Field names of older datasets -> the config's names, for
+#: :meth:`VirtualExperiment.from_dataset`.
 _LEGACY_FIELDS = {
     "eta": "eta_s",
     "drag_rate": "drag_rate_per_s",
@@ -118,10 +118,9 @@ class VirtualExperiment:
         Relative standard deviation of the reference shots' striker speed; None: the
         same as ``speed_mismatch``. The random draws are the same whatever the value.
     radius_dispersion : float
-        Relative standard deviation of the bead radii (dimensionless; 0: equal beads).
-        Each bead's radius is R (1 + s e), e standard normal, its mass and its contacts'
-        stiffness follow; drawn once per chain (one set of beads for every shot), from
-        ``default_rng((seed, CHAIN_STREAM))``, so the shot draws are unchanged.
+        Relative standard deviation s of the bead radii (0: equal beads): each radius
+        is R (1 + s e), e standard normal, drawn once per chain (one set of beads for
+        every shot) from ``default_rng((seed, CHAIN_STREAM))``, apart from the shots'.
     gap_mean_m, gap_spread_m : float
         Mean and standard deviation of the gap between neighbouring beads at rest, m
         (0: barely touching); gap k = max(0, mean + spread e), once per chain as above.
@@ -164,8 +163,7 @@ class VirtualExperiment:
     right_delay_s: float = 0.0
 
     def __post_init__(self) -> None:
-        # Checked in field order; lists from a config become tuples (the dataclass is
-        # frozen, hence object.__setattr__).
+        # Checked in field order; lists from a config become tuples.
         require_int("n_beads", self.n_beads, 2)
         beads = check_bead_numbers("sensor_beads", self.sensor_beads, self.n_beads)
         object.__setattr__(self, "sensor_beads", beads)
@@ -206,13 +204,8 @@ class VirtualExperiment:
 
     @classmethod
     def from_dict(cls, mapping: Mapping) -> VirtualExperiment:
-        """Settings from a plain mapping (a config section); unknown keys are errors.
-
-        Parameters
-        ----------
-        mapping : dict
-            Field names to values (lists are accepted for tuples).
-        """
+        """Settings from a plain ``mapping`` of field names to values (a config section;
+        lists are accepted for tuples); unknown keys are errors."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(mapping) - known)
         if unknown:
@@ -223,14 +216,9 @@ class VirtualExperiment:
 
     @classmethod
     def from_dataset(cls, folder: str | os.PathLike) -> VirtualExperiment:
-        """The settings that wrote a virtual dataset, read back from its
-        ``metadata.yaml`` (to regenerate it, or to simulate it without noise).
-
-        Parameters
-        ----------
-        folder : path
-            A dataset folder written by :func:`run_virtual_experiment`.
-        """
+        """The settings that wrote the virtual dataset in ``folder`` (written by
+        :func:`run_virtual_experiment`), read back from its ``metadata.yaml`` (to
+        regenerate it, or to simulate it without noise)."""
         path = Path(folder) / METADATA_FILE
         read_metadata(folder)  # checks the format, names the file on error
         mapping = yaml.safe_load(path.read_text(encoding="utf-8"))
@@ -312,13 +300,8 @@ LAUNCHES = ("striker", "bead")
 
 
 def check_switches(settings: VirtualExperiment) -> None:
-    """Check the readout and launch switches and ``reference_speed_mismatch``.
-
-    Raises
-    ------
-    ParameterError
-        Naming the field and what is allowed.
-    """
+    """Check the readout and launch switches and ``reference_speed_mismatch``; a
+    :class:`ParameterError` names the field and what is allowed."""
     if settings.readout not in READOUTS:
         raise ParameterError(f"readout must be one of {READOUTS}, got {settings.readout!r}")
     if settings.launch not in LAUNCHES:

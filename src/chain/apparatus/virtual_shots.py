@@ -140,19 +140,14 @@ def _sensor_forces(settings, model, plan, dt, record_interval, rest):
 def simulate_virtual_shots(
     settings: VirtualExperiment, plan: pd.DataFrame
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Integrate the shots of ``plan`` (from :func:`plan_shots`) with the apparatus model.
+    """Integrate the shots of ``plan`` (from :func:`plan_shots`) with the apparatus model:
+    (simulated fine time (S,) s from the first impact, sensor readings (B, n_sensors, S)
+    N of every shot of ``plan``, in plan order).
 
     Collision shots use a chain with both strikers, reference shots one with the left
     striker only, both with the same time step; each kind is batched. With
     ``launch="bead"`` there are no strikers (the end beads are launched) and with
     ``readout="felt"`` no split sensor beads.
-
-    Returns
-    -------
-    time : (S,) s
-        Simulated (fine) time, from the first impact.
-    forces : (B, n_sensors, S) N
-        Sensor readings of every shot of ``plan``, in plan order.
     """
     check_switches(settings)
     radii, gaps = chain_draws(settings)

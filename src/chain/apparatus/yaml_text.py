@@ -1,6 +1,5 @@
 """YAML text as the metadata is read: ``1e-6`` a number, a syntax error with its line,
-and the line of every node (for messages that name the line).
-"""
+and the line of every node (for messages that name the line)."""
 
 from __future__ import annotations
 

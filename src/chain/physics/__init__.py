@@ -8,28 +8,12 @@ from chain._lazy import lazy_exports
 __getattr__, __dir__, __all__ = lazy_exports(
     __name__,
     {
-        **dict.fromkeys(
-            [
-                "MATERIALS",
-                "STEEL_100C6",
-                "Material",
-                "contact_stiffness",
-                "get_material",
-                "sphere_mass",
-            ],
-            "chain.physics.materials",
-        ),
-        **dict.fromkeys(
-            ["PCB_200B02_STIFFNESS", "ChainModel", "Striker", "launch_velocities"],
-            "chain.physics.model",
-        ),
-        **dict.fromkeys(["build_chain", "uniform_chain"], "chain.physics.builders"),
-        **dict.fromkeys(
-            ["IntegrationError", "integrate", "integrate_many"], "chain.physics.integrator"
-        ),
-        **dict.fromkeys(
-            ["SimulationResult", "simulate", "simulate_many"], "chain.physics.simulation"
-        ),
-        "default_time_step": "chain.physics.time_step",
+        "chain.physics.materials": "MATERIALS STEEL_100C6 Material contact_stiffness "
+        "get_material sphere_mass",
+        "chain.physics.model": "PCB_200B02_STIFFNESS ChainModel Striker launch_velocities",
+        "chain.physics.builders": "build_chain uniform_chain",
+        "chain.physics.integrator": "IntegrationError integrate integrate_many",
+        "chain.physics.simulation": "SimulationResult simulate simulate_many",
+        "chain.physics.time_step": "default_time_step",
     },
 )

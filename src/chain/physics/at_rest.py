@@ -123,10 +123,6 @@ def integrate_launch(u, v, params, dt, n_steps, record_every, links, particles, 
         Recorded link and particle indices.
     outputs : tuple of arrays
         The launch's zeroed records.
-
-    Returns
-    -------
-    (status, step, refined)
     """
     span = quiet_span(u, v)
     if span is None:

@@ -1,6 +1,5 @@
 """Building a :class:`~chain.physics.model.ChainModel`: any beads (:func:`build_chain`)
-or the paper's N equal beads (:func:`uniform_chain`), with sensor beads, strikers, walls.
-"""
+or the paper's N equal beads (:func:`uniform_chain`), with sensor beads, strikers, walls."""
 
 from __future__ import annotations
 

@@ -1,12 +1,11 @@
 """Each version of a numba kernel compiled by one process at a time.
 
-numba compiles a kernel once per kind of model (its argument types; ~15-20 s of CPU
+numba compiles a kernel once per kind of model (its argument types; seconds of CPU
 for the step loop) and keeps the result in its cache, but two processes that need
-the same version while the cache lacks it both compile it. A fresh clone's paper run
-did: its second damped-chain job started while the first was still compiling, and
-compiled the damped kernel again (17 s of one of the two cores). :func:`shared` takes a
-lock per version first: the second process waits for the first, then loads the
-first's result from numba's cache. The compiled code is the same either way.
+the same version while the cache lacks it both compile it (a fresh clone's two
+damped-chain jobs). :func:`shared` takes a lock per version first: the second process
+waits for the first, then loads the first's result from numba's cache. The compiled
+code is the same either way.
 """
 
 from __future__ import annotations
@@ -25,9 +24,8 @@ def shared(kernel):
     under a lock that other processes take too; a decorator above ``numba.njit``.
 
     numba's dispatcher compiles only when none of its versions fits a call's types, so
-    a call costs nothing more: typing the arguments in Python at every call (as before)
-    cost ~0.4 ms a launch, 5-8 % of the paper's collision. Any other callable (a test's
-    stand-in) is returned as it is.
+    a call costs nothing more (typing the arguments in Python at every call would cost
+    ~0.4 ms a launch). Any other callable (a test's stand-in) is returned as it is.
     """
     if not hasattr(kernel, "overloads"):
         return kernel

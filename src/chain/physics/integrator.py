@@ -18,9 +18,9 @@ import numba
 import numpy as np
 
 from chain.errors import ParameterError, require_int, require_positive
-from chain.physics.kernels import _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
+from chain.physics.kernels import _OK
 from chain.physics.launches import _lean_launches, _reference_launches, _run_launches
-from chain.physics.model import HERTZ, SPRING, ChainModel
+from chain.physics.model import ChainModel
 
 #: Default bound on the relative energy drift before a run is declared broken.
 DEFAULT_MAX_ENERGY_DRIFT = 1e-6
@@ -116,10 +116,6 @@ def integrate(
     kernel : {"lean", "reference"}
         "reference" runs the general kernel of :mod:`chain.physics.reference_kernel`
         (same results bit for bit, slower; for tests and benchmarks).
-
-    Returns
-    -------
-    RawTrajectory
     """
     batch = _prepare(
         model,
@@ -138,9 +134,10 @@ def integrate(
 
 
 def integrate_many(batches: Sequence[Mapping], threads: int | None = None) -> list[RawTrajectory]:
-    """Integrate several batches (different chains, steps, durations) at once: every
-    launch of every batch is one task of one pool of ``threads`` threads, longest first,
-    so that a sweep of many small chains keeps every core busy.
+    """Integrate several batches (different chains, steps, durations) at once, one
+    RawTrajectory per batch, in order: every launch of every batch is one task of one
+    pool of ``threads`` threads, longest first, so that a sweep of many small chains
+    keeps every core busy.
 
     Each launch gives the same bits as :func:`integrate` would (one launch runs on one
     thread, whatever the pool).
@@ -153,11 +150,6 @@ def integrate_many(batches: Sequence[Mapping], threads: int | None = None) -> li
     threads : int, optional
         Threads of the pool; default numba's thread count (all cores unless limited by
         ``NUMBA_NUM_THREADS`` or :func:`numba.set_num_threads`).
-
-    Returns
-    -------
-    list of RawTrajectory
-        One per batch, in order.
     """
     prepared = []
     for number, arguments in enumerate(batches):
@@ -308,10 +300,6 @@ def _batch_array(name: str, values, n_particles: int) -> np.ndarray:
 
 __all__ = [
     "DEFAULT_MAX_ENERGY_DRIFT",
-    "EVENT_AFTERMATH",
-    "EVENT_SUBSTEPS",
-    "HERTZ",
-    "SPRING",
     "IntegrationError",
     "RawTrajectory",
     "integrate",

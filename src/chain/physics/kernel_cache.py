@@ -2,15 +2,12 @@
 
 numba keys a cached kernel on its own file (time stamp and size) and its own function's
 bytecode: what the kernel inlines from another file, and the constants it reads from
-one, are not part of the key. A kernel of :mod:`chain.physics.kernels`, which inlines
-the right-hand side of :mod:`chain.physics.slopes`, was loaded from the cache unchanged
-after slopes.py was edited (checked on 27 Nov 2026: a doubled Hertz force there left
-the recorded forces as they were until the cache was emptied), and
-:mod:`chain.physics.reference_kernel` reads kernels.py's constants.
-:func:`forget_if_sources_changed` keeps a digest of the sources in each kernel's cache
-folder and removes the kernels' cache indexes when it changes, so that numba compiles
-them again. The digest covers every source of the physics kernels: an edit to any of
-them recompiles them all (seconds), never a stale one.
+one, are not part of the key. So a kernel of :mod:`chain.physics.kernels` would be
+loaded unchanged after an edit of :mod:`chain.physics.slopes`, whose right-hand side it
+inlines. :func:`forget_if_sources_changed` keeps a digest of the sources in each
+kernel's cache folder and removes the kernels' cache indexes when it changes, so that
+numba compiles them again. The digest covers every source of the physics kernels: an
+edit to any of them recompiles them all (seconds), never a stale one.
 """
 
 from __future__ import annotations
@@ -37,7 +34,8 @@ def sources_digest(sources: Iterable[str | os.PathLike]) -> str:
 def forget_if_sources_changed(module: str, namespace: dict, sources: Iterable | None = None):
     """Remove the cache indexes of the numba kernels that ``module`` defines when
     ``sources`` changed since the digest kept beside them; then keep the new digest.
-    Call it at the end of the module, before any of its kernels runs.
+    Call it at the end of the module, before any of its kernels runs. Returns whether
+    indexes were removed (the sources changed, or no digest was kept).
 
     Parameters
     ----------
@@ -50,11 +48,6 @@ def forget_if_sources_changed(module: str, namespace: dict, sources: Iterable | 
         written, is left alone (numba then compiles it in every process anyway).
     sources : iterable of paths, optional
         The files they are compiled from; by default :data:`SOURCES` beside this module.
-
-    Returns
-    -------
-    bool
-        Whether indexes were removed (the sources changed, or no digest was kept).
     """
     here = Path(__file__).parent
     files = [here / s for s in SOURCES] if sources is None else list(sources)

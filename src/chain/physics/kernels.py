@@ -1,10 +1,9 @@
-"""The lean RK4 kernel behind :func:`chain.physics.integrator.integrate`.
-
-Its right-hand side is :mod:`chain.physics.slopes`.
+"""The lean RK4 kernel behind :func:`chain.physics.integrator.integrate`; its right-hand
+side is :mod:`chain.physics.slopes`.
 
 Same scheme and the same floating-point operations, in the same order, as the general
 kernel (:mod:`chain.physics.reference_kernel`), so the two give bit-identical results;
-what changed is the bookkeeping around the arithmetic:
+only the bookkeeping around the arithmetic differs:
 
 * **First same as last.** The slopes at the end of a step are the first stage of the
   next one, so every step evaluates the right-hand side exactly four times, and the
@@ -21,8 +20,8 @@ what changed is the bookkeeping around the arithmetic:
   branch on the link kind (every link as a Hertz contact, the bonded sensor springs
   over them, then the accelerations), so that numba's LLVM computes several links per
   SIMD instruction; the Kuwabara-Kono term is one flag per model.
-* **One RK4 step for plain steps and substeps** (see _integrate_part), compiled once
-  by numba and inlined by LLVM where it is called.
+* **One RK4 step for plain steps and substeps**, compiled once by numba and inlined
+  by LLVM where it is called.
 * **Only what is asked is recorded**: chosen links and particles, the two wall
   forces, the energies and the momentum. The state is checked for non-finite values
   at recorded samples only (a non-finite value never becomes finite again).
@@ -47,8 +46,7 @@ _NOT_FINITE = 1
 
 #: Contact events (a Hertz contact opening or closing) are integrated in
 #: EVENT_SUBSTEPS substeps, for the step where they happen and the EVENT_AFTERMATH
-#: steps after it: the force kappa delta^(3/2) has an unbounded second derivative at
-#: delta = 0, which costs RK4 its order on exactly those steps.
+#: steps after it (see above).
 EVENT_SUBSTEPS = 16
 EVENT_AFTERMATH = 3
 
@@ -182,23 +180,15 @@ def _plain_step(
     return increment, end, varied
 
 
-# A refined step is EVENT_SUBSTEPS plain steps of dt / EVENT_SUBSTEPS through the same
-# code, which numba compiled once more (and in a function of its own) before: one copy
-# fewer of the step to compile, the same speed. The step is inlined at two call sites,
-# one per order of the arrays, so that the loop never swaps array variables: a swap
-# costs reference-count updates. Bits unchanged.
-
-
 def _integrate_one(u, v, params, dt, n_steps, record_every, links, particles, outputs):
     """RK4 for one launch of the whole chain; ``u`` and ``v`` end as the final state.
     Returns the status, the step at which it was set, and the number of steps refined
     at contact events.
 
-    Plain Python around the compiled step loop, not a numba entry point of its own: as
-    one, numba lowered and optimised the whole loop a second time (~3 s of each cold
-    compile, per kind of model). Python ints and floats reach the loop as int64 and
-    float64, as chain.physics.at_rest's do, so numba compiles it once per kind (a
-    literal argument would compile it again)."""
+    Plain Python around the compiled step loop: as a numba entry point of its own, it
+    would lower and optimise the whole loop a second time (~3 s of each cold compile).
+    Its ints and floats reach the loop as int64 and float64, as chain.physics.at_rest's
+    do, so numba compiles the loop once per kind of model."""
     links = (links, np.arange(links.shape[0]))
     particles = (particles, np.arange(particles.shape[0]))
     status, step, refined, _, _, _ = _integrate_part(
@@ -244,6 +234,11 @@ def _work_buffers(n):
     )  # fmt: skip
 
 
+# A refined step is EVENT_SUBSTEPS plain steps of dt / EVENT_SUBSTEPS through the same
+# inlined step, at two call sites, one per order of the arrays, so that the loop never
+# swaps array variables (a swap costs reference-count updates). One function, 62 lines:
+# split into named steps it gives the same bits but compiles ~1.8 s longer per kind of
+# model and runs ~2.5 % slower with Kuwabara-Kono (benchmarks/kernel_breakdown.py --split).
 @compile_once.shared
 @numba.njit(cache=CACHE, nogil=True)
 def _integrate_part(

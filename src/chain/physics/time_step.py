@@ -18,7 +18,7 @@ from chain.physics.theory import hertz_contact_time
 #: Hertz scaling makes the energy drift a function of dt / t_c only; 1000 keeps the
 #: conservative drift of the paper's N = 26 chain near 3e-10 over 2.6 ms at any launch
 #: speed (RK4's own truncation error; the steps where a contact opens or closes are
-#: refined by the integrator, see chain.physics.integrator.EVENT_SUBSTEPS).
+#: refined by the integrator, see chain.physics.kernels.EVENT_SUBSTEPS).
 STEPS_PER_CONTACT_TIME = 1000
 
 #: Steps per period of the stiffest bonded spring (sensor beads) in the default step.

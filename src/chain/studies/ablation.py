@@ -1,18 +1,15 @@
 """Ablation of the virtual experiment: rerun it with one ingredient changed at a time.
 
 The virtual experiment (:mod:`chain.apparatus.virtual`, a MODEL of the apparatus) is
-the paper's simulation plus apparatus ingredients: strikers instead of a launched end
-bead, split sensor beads instead of a point readout, Kuwabara-Kono dissipation, noise
-and a digitiser, shot-to-shot speed mismatch and launch jitter, the 5 % acceptance
-protocol and its own range of amplitudes. A variant changes some of them
+the paper's simulation plus apparatus ingredients, the 5 % acceptance protocol and its
+own range of amplitudes. A variant changes some of them
 (:mod:`chain.pipeline.config.ablation` maps the config's ``ablation.variants`` to the
-settings of each chain). :func:`run_variant` runs the virtual experiment of every
+settings of each chain). :func:`run_variant_shots` runs the virtual experiment of every
 chain with those settings (the same seed as the run, so a variant with no overrides
-reproduces the run's experiment) and fits Delta = C F_m^(-1/6) and a free power law
-as every series is fitted (:mod:`chain.analysis.recipe`); replicates repeat it with other seeds
-to show the spread a seed gives (:mod:`chain.studies.ablation_table`).
-
-This module reads no config and knows no Snakemake.
+reproduces the run's experiment) and :func:`variant_fits` fits Delta = C F_m^(-1/6) and
+a free power law as every series is fitted (:mod:`chain.analysis.recipe`); replicates
+repeat it with other seeds to show the spread a seed gives
+(:mod:`chain.studies.ablation_table`).
 """
 
 from __future__ import annotations
@@ -34,15 +31,21 @@ from chain.labels import VIRTUAL_SERIES
 from chain.studies.mechanism_fits import variant_ssw_fits
 
 
-def run_variant(
+def run_variant_shots(
     settings_per_chain: Sequence[Mapping],
     tolerance: float | None,
     estimators: Sequence[str] = ("fit_full",),
     series: str = VIRTUAL_SERIES,
-) -> pd.DataFrame:
-    """Run the virtual experiment on each chain, analyse it as the pipeline does, and
-    fit |Delta| against F_m (:func:`run_variant_shots`, then
-    :func:`chain.analysis.recipe.fit_pulses`).
+    datasets: Sequence[str | os.PathLike] | None = None,
+) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
+    """Run the virtual experiment on each chain and fit its pulses and select its shots
+    as the pipeline does; returns what :func:`analyse_datasets` does.
+
+    The shots go through the measured-data path: written in the measured-trace format
+    to a temporary folder, then analysed by :func:`analyse_datasets`. With
+    ``datasets`` (one folder per chain, written by the virtual experiment with exactly
+    ``settings_per_chain`` and ``series``: the run's own), those are analysed instead
+    of simulating the same shots again.
 
     Parameters
     ----------
@@ -55,36 +58,8 @@ def run_variant(
         Pulse estimators (:data:`chain.analysis.pulses.ESTIMATORS`).
     series : str
         Series name (the ``model`` column).
-
-    Returns
-    -------
-    DataFrame
-        :data:`chain.analysis.delays.DELAY_FIT_COLUMNS` rows of source "experiment".
-    """
-    _, pulses, selection = run_variant_shots(settings_per_chain, tolerance, estimators, series)
-    return fit_pulses(pulses, selection)
-
-
-def run_variant_shots(
-    settings_per_chain: Sequence[Mapping],
-    tolerance: float | None,
-    estimators: Sequence[str] = ("fit_full",),
-    series: str = VIRTUAL_SERIES,
-    datasets: Sequence[str | os.PathLike] | None = None,
-) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
-    """Run the virtual experiment on each chain and fit its pulses and select its shots
-    as the pipeline does (parameters as :func:`run_variant`).
-
-    The shots go through the measured-data path: written in the measured-trace format
-    to a temporary folder, then analysed by :func:`analyse_datasets`. With
-    ``datasets`` (one folder per chain, written by the virtual experiment with exactly
-    ``settings_per_chain`` and ``series``: the run's own, see
-    :meth:`chain.pipeline.plan.run_plan.RunPlan.ablation_datasets`), those are analysed instead
-    of simulating the same shots again.
-
-    Returns
-    -------
-    As :func:`analyse_datasets`.
+    datasets : sequence of path, optional
+        The chains' dataset folders, already written.
     """
     if datasets:
         return analyse_datasets(datasets, tolerance, estimators, series)
@@ -103,23 +78,15 @@ def analyse_datasets(
     series: str = VIRTUAL_SERIES,
 ) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
     """Load a variant's shots, fit their pulses per chain and select the collisions
-    with ``tolerance``, as the pipeline does.
+    with ``tolerance``, as the pipeline does: (the trace table of each chain, their
+    pulse rows, the shot selection or None with ``tolerance`` None).
 
     Parameters
     ----------
     datasets : sequence of path
         Dataset folders in the measured-trace format, one per chain.
     tolerance, estimators, series
-        As :func:`run_variant`.
-
-    Returns
-    -------
-    traces : list of DataFrame
-        The trace table of each chain.
-    pulses : DataFrame
-        Their pulse rows (:func:`chain.analysis.pulse_rows.pulse_table`).
-    selection : DataFrame or None
-        The shot selection (None with ``tolerance`` None).
+        As :func:`run_variant_shots`.
     """
     traces = [load_dataset(folder, name=series) for folder in datasets]
     table = pd.concat(
@@ -137,8 +104,10 @@ def variant_fits(
     tolerance: float | None,
     estimators: Sequence[str],
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """A variant's delay fits and SSW fits at S2 with each estimator, each with the
-    shot selection the acceptance protocol makes with that estimator.
+    """A variant's delay fits (:func:`chain.analysis.recipe.fit_pulses` rows) and SSW
+    fits at S2 (:func:`chain.studies.mechanism_fits.variant_ssw_fits` rows with an
+    ``estimator`` column) with each estimator, one after the other, each with the shot
+    selection the acceptance protocol makes with that estimator.
 
     Every estimator is fitted so that a what-if choosing another main estimator
     reuses the variant (its simulation is the costly part); the tables reporting it
@@ -154,14 +123,6 @@ def variant_fits(
         Acceptance tolerance of the 5 % protocol (relative); None keeps every shot.
     estimators : sequence of str
         Pulse estimators.
-
-    Returns
-    -------
-    fits : DataFrame
-        :func:`chain.analysis.recipe.fit_pulses` rows, one estimator after the other.
-    ssw_fits : DataFrame
-        :func:`chain.studies.mechanism_fits.variant_ssw_fits` rows, likewise, with an
-        ``estimator`` column.
     """
     fits, ssw_fits = [], []
     for estimator in estimators:

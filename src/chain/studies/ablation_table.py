@@ -2,7 +2,7 @@
 every variant of the virtual experiment, at the run's seed and over the seeds of its
 replicates.
 
-The fits come from :func:`chain.studies.ablation.run_variant` (one ``_fits.csv`` per
+The fits come from :func:`chain.studies.ablation.variant_fits` (one ``_fits.csv`` per
 variant); this module only tabulates them, so that the table job needs neither the
 simulation nor the pulse fits.
 """
@@ -17,22 +17,9 @@ import pandas as pd
 from chain.labels import VIRTUAL_LABEL
 
 #: Columns of :func:`ablation_table`, in order (after ``exponent_stderr``: extras).
-ABLATION_COLUMNS = (
-    "variant",
-    "N",
-    "C",
-    "C_stderr",
-    "exponent",
-    "exponent_stderr",
-    "n_points",
-    "estimator",
-    "n_seeds",
-    "C_seed_mean",
-    "C_seed_std",
-    "exponent_seed_mean",
-    "exponent_seed_std",
-    "series",
-    "overrides",
+ABLATION_COLUMNS = tuple(
+    "variant N C C_stderr exponent exponent_stderr n_points estimator n_seeds C_seed_mean "
+    "C_seed_std exponent_seed_mean exponent_seed_std series overrides".split()
 )
 
 
@@ -42,7 +29,7 @@ def ablation_table(fits: Mapping[str, pd.DataFrame], overrides: Mapping[str, str
     Parameters
     ----------
     fits : mapping
-        Variant name -> its fits (:func:`chain.studies.ablation.run_variant` rows with a
+        Variant name -> its fits (:func:`chain.studies.ablation.variant_fits` rows with a
         ``replicate`` column; replicate 0 is the run's seed).
     overrides : mapping
         Variant name -> its overrides as text (for the ``overrides`` column).

@@ -1,4 +1,4 @@
-"""How much the fitted C of Delta = C F_m^(-1/6) depends on our choices (issue 13, item 7).
+"""How much the fitted C of Delta = C F_m^(-1/6) depends on our choices.
 
 Starting from the headline choice (the main estimator, the paper's Kuwabara-Kono time
 eta, the configured sensors, every configured launch speed), one choice is changed at
@@ -30,21 +30,9 @@ from chain.traces import META_COLUMNS, sensor_column
 SENSOR_SHIFTS = (2, -2, -4)
 
 #: Columns of :func:`c_sensitivity_table`, in order (after ``exponent_stderr``: extras).
-C_SENSITIVITY_COLUMNS = (
-    "choice",
-    "value",
-    "N",
-    "C",
-    "C_stderr",
-    "exponent",
-    "exponent_stderr",
-    "n_points",
-    "estimator",
-    "eta_us",
-    "sensors",
-    "amplitudes",
-    "headline",
-    "note",
+C_SENSITIVITY_COLUMNS = tuple(
+    "choice value N C C_stderr exponent exponent_stderr n_points estimator eta_us sensors "
+    "amplitudes headline note".split()
 )
 
 
@@ -201,11 +189,9 @@ def _rows(choice, value, fits, estimator, eta, pairs, amplitudes, chains, eta_pa
 def c_sensitivity_every_estimator(
     traces: Mapping[float, Mapping[int, pd.DataFrame]], plan: Mapping
 ) -> pd.DataFrame:
-    """:func:`c_sensitivity_table` with each estimator of ``plan`` as the headline one.
-
-    The study's job computes this (its simulations are the cost), so that a what-if
-    choosing another main estimator reuses it; the reported table is the main
-    estimator's rows (``chain.analysis.rows.picked``).
+    """:func:`c_sensitivity_table` with each estimator of ``plan`` as the headline one, so
+    that a what-if choosing another main estimator reuses the study's job; the reported
+    table is the main estimator's rows (``chain.analysis.rows.picked``).
 
     Parameters
     ----------

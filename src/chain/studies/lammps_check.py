@@ -21,20 +21,9 @@ from chain.studies.mechanism_fits import analyse_traces
 from chain.studies.mechanism_settings import granular_chain
 
 #: Columns of ``tables/lammps_check.csv``.
-CHECK_COLUMNS = (
-    "N",
-    "model",
-    "eta_s",
-    "n_speeds",
-    "C_kernel",
-    "C_kernel_stderr",
-    "C_lammps",
-    "rel_diff_C",
-    "max_trace_diff_over_Fm",
-    "max_trace_diff_N",
-    "dt_kernel_s",
-    "dt_lammps_s",
-    "within_tolerance",
+CHECK_COLUMNS = tuple(
+    "N model eta_s n_speeds C_kernel C_kernel_stderr C_lammps rel_diff_C "
+    "max_trace_diff_over_Fm max_trace_diff_N dt_kernel_s dt_lammps_s within_tolerance".split()
 )
 
 #: The cross-check's targets: C within this relative difference, and every sensor
@@ -44,14 +33,9 @@ TRACE_TOLERANCE = 1e-4
 
 
 def trace_difference(first: pd.DataFrame, second: pd.DataFrame) -> tuple[float, float]:
-    """Largest |difference| of two trace tables of the same shots, sample by sample:
-    (over the shot's F_m, in N). F_m of a shot is its largest sensor force in ``first``.
-
-    Parameters
-    ----------
-    first, second : DataFrame
-        Trace tables with the same shots, sensors and sample times.
-    """
+    """Largest |difference| of two trace tables with the same shots, sensors and sample
+    times, sample by sample: (over the shot's F_m, in N). F_m of a shot is its largest
+    sensor force in ``first``."""
     columns = [c for c in first.columns if c.startswith("force_bead")]
     worst_ratio, worst = 0.0, 0.0
     for shot, group in first.groupby("shot", sort=True):

@@ -1,7 +1,6 @@
 """One setting of the mechanism study's friction/rotation (or viscous) sweep on one
 chain, run by LAMMPS (:mod:`chain.physics.lammps_engine`, optional) and analysed as
-every other series. This module maps config keys and knows no Snakemake.
-"""
+every other series. This module maps config keys and knows no Snakemake."""
 
 from __future__ import annotations
 
@@ -11,11 +10,7 @@ import pandas as pd
 
 from chain.apparatus.lammps_shots import lammps_shots
 from chain.studies.mechanism_fits import analyse_per_estimator
-from chain.studies.mechanism_settings import (
-    granular_chain,
-    sweep_settings,
-    viscous_settings,
-)
+from chain.studies.mechanism_settings import granular_chain, sweep_settings, viscous_settings
 
 
 def run_sweep_setting(

@@ -19,7 +19,9 @@ from chain.analysis.ssw import ssw_fit_table, ssw_table
 
 
 def analyse_traces(traces: pd.DataFrame, estimator: str) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """C and the SSW slope at S2 of one trace table, as the pipeline analyses any series.
+    """C and the SSW slope at S2 of one trace table, as the pipeline analyses any series:
+    (:func:`chain.analysis.recipe.fit_pulses` rows, per N and pooled;
+    :func:`chain.analysis.ssw.ssw_fit_table` rows of the S2 readings, SSW behind LSTW).
 
     Parameters
     ----------
@@ -27,13 +29,6 @@ def analyse_traces(traces: pd.DataFrame, estimator: str) -> tuple[pd.DataFrame, 
         A trace table (collision and reference shots per amplitude).
     estimator : str
         Pulse estimator (:data:`chain.analysis.pulses.ESTIMATORS`).
-
-    Returns
-    -------
-    delay_fits : DataFrame
-        :func:`chain.analysis.recipe.fit_pulses` rows (per N and pooled).
-    ssw_fits : DataFrame
-        :func:`chain.analysis.ssw.ssw_fit_table` rows of the S2 readings (SSW behind LSTW).
     """
     pulses = pulse_table(traces, estimators=(estimator,))
     ssw = ssw_table(traces, pulses, estimator=estimator)
@@ -43,7 +38,8 @@ def analyse_traces(traces: pd.DataFrame, estimator: str) -> tuple[pd.DataFrame, 
 def analyse_per_estimator(
     traces: pd.DataFrame, estimators: Sequence[str]
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """:func:`analyse_traces` with each estimator, rows tagged with it.
+    """:func:`analyse_traces` with each estimator, one after the other, rows tagged with
+    it in an ``estimator`` column (:func:`chain.analysis.rows.of_estimator` picks one).
 
     Parameters
     ----------
@@ -51,12 +47,6 @@ def analyse_per_estimator(
         A trace table (collision and reference shots per amplitude).
     estimators : sequence of str
         Pulse estimators (:data:`chain.analysis.pulses.ESTIMATORS`).
-
-    Returns
-    -------
-    delay_fits, ssw_fits : DataFrame
-        Those of :func:`analyse_traces`, one estimator after the other, with an
-        ``estimator`` column (:func:`chain.analysis.rows.of_estimator` picks one).
     """
     delay_fits, ssw_fits = [], []
     for estimator in estimators:

@@ -1,4 +1,4 @@
-"""The mechanism study's settings (issue 24): which friction/rotation and viscous
+"""The mechanism study's settings: which friction/rotation and viscous
 settings the LAMMPS sweep runs, their names, the LAMMPS chain of a setting, and which
 ablation variants of the virtual experiment are its candidates.
 

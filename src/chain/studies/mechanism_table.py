@@ -14,15 +14,8 @@ import numpy as np
 import pandas as pd
 
 #: Columns of ``tables/ssw_mechanisms.csv`` (the results contract).
-MECHANISM_COLUMNS = (
-    "mechanism",
-    "setting",
-    "N",
-    "ssw_over_Fm",
-    "ssw_over_Fm_err",
-    "ratio_to_frictionless",
-    "C",
-    "C_stderr",
+MECHANISM_COLUMNS = tuple(
+    "mechanism setting N ssw_over_Fm ssw_over_Fm_err ratio_to_frictionless C C_stderr".split()
 )
 
 #: Mechanism name of the LAMMPS friction/rotation rows.

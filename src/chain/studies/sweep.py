@@ -14,29 +14,16 @@ from collections.abc import Mapping
 import pandas as pd
 
 #: Columns of ``tables/sweep.csv``, in order.
-SWEEP_COLUMNS = (
-    "model",
-    "eta_s",
-    "N",
-    "parity",
-    "C_us_N16",
-    "C_stderr_us_N16",
-    "exponent",
-    "exponent_stderr",
-    "n_delays",
-    "ssw_slope",
-    "ssw_slope_stderr",
-    "n_ssw",
+SWEEP_COLUMNS = tuple(
+    "model eta_s N parity C_us_N16 C_stderr_us_N16 exponent exponent_stderr n_delays "
+    "ssw_slope ssw_slope_stderr n_ssw".split()
 )
 #: The SSW measurement taken from ``ssw_fits.csv`` when it holds several.
 SSW_METHOD = "residual"
 
 
 def sweep_table(
-    delay_fits: pd.DataFrame,
-    ssw_fits: pd.DataFrame,
-    eta_s: Mapping[str, float],
-    estimator: str,
+    delay_fits: pd.DataFrame, ssw_fits: pd.DataFrame, eta_s: Mapping[str, float], estimator: str
 ) -> pd.DataFrame:
     """C(N) and SSW slope(N) of every simulated model, one row per model and chain.
 
@@ -67,9 +54,7 @@ def sweep_table(
         columns={"slope": "ssw_slope", "slope_stderr": "ssw_slope_stderr", "n_points": "n_ssw"}
     )
     table = delays.rename(columns={"n_points": "n_delays"}).merge(
-        ssw[["model", "N", "ssw_slope", "ssw_slope_stderr", "n_ssw"]],
-        on=["model", "N"],
-        how="left",
+        ssw[["model", "N", "ssw_slope", "ssw_slope_stderr", "n_ssw"]], on=["model", "N"], how="left"
     )
     table["eta_s"] = table["model"].map(lambda name: eta_s.get(name, float("nan")))
     table["parity"] = ["even" if n % 2 == 0 else "odd" for n in table["N"]]

@@ -31,11 +31,7 @@ def fig1_setup(
     material: str = "steel_100C6",
     max_rows: int = 6,
 ) -> Figure:
-    """Fig. 1: the setup, one chain per row, drawn to scale from the configuration.
-
-    N beads on the track, the two strikers, the split sensor beads S1 and S2 wired to
-    the acquisition, and the directions of the left- and right-launched waves (LSTW,
-    RSTW).
+    """Fig. 1: the setup (see the module docstring), one chain per row.
 
     Parameters
     ----------

@@ -1,9 +1,6 @@
-"""Fig. 2: experiment forces at the sensor beads, (A, B) N = 25, (C, D) N = 26.
-
-The panels are those of Fig. 3 (:mod:`chain.report.figures.trace_panels`), drawn from the
-experiment's trace tables (virtual or measured) and showing a collision shot that the
-acceptance protocol kept.
-"""
+"""Fig. 2: experiment forces at the sensor beads, (A, B) N = 25, (C, D) N = 26: the
+panels of Fig. 3 (:mod:`chain.report.figures.trace_panels`) for a collision shot that
+the acceptance protocol kept."""
 
 from __future__ import annotations
 
@@ -28,18 +25,13 @@ def fig2_experiment_traces(
 ) -> Figure:
     """Fig. 2: experiment forces at S1 and S2, (A, B) N = 25, (C, D) N = 26.
 
-    Same layout and notation as
-    :func:`chain.report.figures.fig3_simulation_traces.fig3_simulation_traces`; ``traces`` are
-    experiment trace tables (``source == "experiment"``, virtual or measured), and
-    ``label`` names them (``"virtual experiment (model)"`` for the model of the
-    apparatus). Parameters as in Fig. 3, and:
-
-    Parameters
-    ----------
-    selection : DataFrame, optional
-        ``experiment/selection.csv`` (:func:`chain.analysis.selection.select_shots`): the
-        collision shot drawn is the first one the acceptance protocol kept, from the
-        amplitudes that have one. None: the first collision shot.
+    Parameters as in
+    :func:`chain.report.figures.fig3_simulation_traces.fig3_simulation_traces`;
+    ``traces`` are experiment trace tables (virtual or measured) and ``label`` names
+    them. ``selection``: ``experiment/selection.csv``
+    (:func:`chain.analysis.selection.select_shots`): the collision shot drawn is the
+    first one the acceptance protocol kept, from the amplitudes that have one (None:
+    the first collision shot).
     """
     return trace_figure(
         traces,

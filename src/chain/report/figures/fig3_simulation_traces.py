@@ -26,13 +26,8 @@ def fig3_simulation_traces(
     """Fig. 3: simulated forces felt by the sensor beads (sensors not modelled).
 
     One column per chain (paper: (A, B) N = 25 at n = 9, 17; (C, D) N = 26 at
-    n = 10, 17), S1 on top and S2 below. In the collision shot the left-launched wave
-    (LSTW) is drawn solid and the right-launched one (RSTW) dashed: at S1 the first
-    pulse is the incident LSTW and the second the crossed RSTW, at S2 the other way
-    round; the trace is split at the minimum between the two pulses (their times from
-    ``pulses``). The reference shot (LSTW alone) is dotted. An inset zooms on what
-    follows the crossed pulse, where the secondary solitary wave (SSW) arrives; its
-    amplitude from ``ssw`` is marked.
+    n = 10, 17), drawn as :mod:`chain.report.figures.trace_panels` describes; the SSW
+    amplitude from ``ssw`` is marked in the inset.
 
     Parameters
     ----------

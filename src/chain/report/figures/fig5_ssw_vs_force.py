@@ -22,13 +22,7 @@ from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
 from chain.report.figures import picks
-from chain.report.figures.style import (
-    STYLE,
-    chain_marker,
-    model_colors,
-    new_figure,
-    plain_numbers,
-)
+from chain.report.figures.style import STYLE, chain_marker, model_colors, new_figure, plain_numbers
 from chain.report.naming import series_name
 from chain.report.printed import plus_minus_stat_sys
 

@@ -8,21 +8,12 @@ from matplotlib.figure import Figure
 
 from chain.analysis.rows import usable_rows
 from chain.report.figures import picks
-from chain.report.figures.style import (
-    STYLE,
-    add_legend,
-    axes_or_new,
-    draw_even_odd,
-    model_colors,
-)
+from chain.report.figures.style import STYLE, add_legend, axes_or_new, draw_even_odd, model_colors
 from chain.report.naming import series_name
 
 
 def fig_parity_ssw_vs_N(
-    ssw_fits: pd.DataFrame,
-    *,
-    experiment_label: str = "experiment",
-    ax=None,
+    ssw_fits: pd.DataFrame, *, experiment_label: str = "experiment", ax=None
 ) -> Figure:
     """SSW slope (SSW amplitude / F_m) against the number of beads N, even chains
     (waves meet at a contact) filled, odd chains (waves meet at a bead) open; a colour

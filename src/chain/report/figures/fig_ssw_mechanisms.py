@@ -11,6 +11,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from chain.report.figures.style import STYLE, add_legend, axes_or_new, chain_marker
+from chain.report.numbers.mechanisms import SIGNIFICANT_RATIO
 
 #: Percent per unit ratio.
 PERCENT = 100.0
@@ -18,8 +19,8 @@ PERCENT = 100.0
 #: Colour of the first and second chain (markers and reference dashes).
 CHAIN_COLORS = ("#1f77b4", "#d95f02")
 
-#: A ratio to the frictionless value that counts as "significantly larger" (issue 24).
-SIGNIFICANT_RATIO = 2.0
+#: The marks of a chain's reference at each category: (times the reference, dash, name).
+REFERENCE_MARKS = ((1, "--", "reference"), (SIGNIFICANT_RATIO, ":", "2 x reference"))
 
 
 def fig_ssw_mechanisms(table: pd.DataFrame, *, ax=None) -> Figure:
@@ -73,25 +74,10 @@ def _draw_references(ax, rows: pd.DataFrame, position: dict, shift, n_beads, k) 
         if not math.isfinite(reference):
             continue
         x = position[(row.mechanism, row.setting)] + shift
-        first = number == 0
-        ax.hlines(
-            PERCENT * reference,
-            x - 0.12,
-            x + 0.12,
-            colors=color,
-            lw=1.0,
-            ls="--",
-            label=f"N = {n_beads}: reference" if first else None,
-        )
-        ax.hlines(
-            SIGNIFICANT_RATIO * PERCENT * reference,
-            x - 0.12,
-            x + 0.12,
-            colors=color,
-            lw=1.0,
-            ls=":",
-            label=f"N = {n_beads}: 2 x reference" if first else None,
-        )
+        for factor, dash, name in REFERENCE_MARKS:
+            level = factor * PERCENT * reference
+            label = f"N = {n_beads}: {name}" if number == 0 else None
+            ax.hlines(level, x - 0.12, x + 0.12, colors=color, lw=1.0, ls=dash, label=label)
 
 
 def _draw_groups(ax, cases: list, position: dict) -> None:

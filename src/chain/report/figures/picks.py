@@ -238,26 +238,10 @@ def pooled_fits(fits, estimator: str):
 def representative_shots(table, pulses, selection, *, source, n, estimator, force, index):
     """The collision and reference shot of one chain drawn in Fig. 2/3 (rows, or None).
 
-    The amplitude is :func:`pick_amplitude`'s, among the amplitudes with a collision
-    the acceptance protocol kept when ``selection`` is given; the shot of each kind is
-    the first one kept (the first one without a selection).
-
-    Parameters
-    ----------
-    table : DataFrame
-        Trace rows of one chain.
-    pulses, selection : DataFrame or None
-        ``pulses.csv``, ``experiment/selection.csv``.
-    source : str
-        ``simulation`` or ``experiment``.
-    n : int
-        Number of beads.
-    estimator : str
-        Estimator whose F_m is used.
-    force : float
-        Wanted incident F_m at S1, N.
-    index : int or None
-        Amplitude index that overrides ``force``.
+    The amplitude is :func:`pick_amplitude`'s (whose parameters it takes, ``force``
+    its ``target_force``, N), among the amplitudes with a collision the acceptance
+    protocol kept when ``selection`` (``experiment/selection.csv`` or None) is given;
+    the shot of each kind is the first one kept (the first one without a selection).
     """
     kept = kept_shots(selection, table)
     amplitude = pick_amplitude(

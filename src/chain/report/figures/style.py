@@ -74,7 +74,8 @@ MICRO = 1e6
 
 
 def save_figure(fig: Figure, path: str | os.PathLike, *, processes: int = 1) -> list[Path]:
-    """Write ``fig`` as ``<path>.pdf`` and ``<path>.png`` with fixed metadata.
+    """Write ``fig`` as ``<path>.pdf`` and ``<path>.png`` with fixed metadata; returns
+    their paths.
 
     Each file is written to a temporary name beside its destination and renamed, so
     an interrupted write never leaves a partial figure. No creation date or software
@@ -90,11 +91,6 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, processes: int = 1) -> 
         Processes that may draw at once (a job's cores): with 2 or more (and
         ``os.fork``), the PNG is drawn in a forked process while this one draws the PDF,
         the same bytes as one after the other (``tests/test_figures.py``).
-
-    Returns
-    -------
-    list of Path
-        The PDF and PNG paths.
     """
     stem = Path(path)
     if stem.suffix in (".pdf", ".png"):

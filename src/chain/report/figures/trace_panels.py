@@ -159,13 +159,7 @@ def draw_sensor(ax, collision, reference, sensor, bead, s2, pulses, ssw, estimat
     (:func:`chain.report.figures.picks.pulse_times`)."""
     column = sensor_column(bead)
     if reference is not None:
-        ax.plot(
-            reference["t_s"] * MICRO,
-            reference[column],
-            color=REFERENCE_COLOR,
-            ls=":",
-            lw=1.4,
-        )
+        ax.plot(reference["t_s"] * MICRO, reference[column], color=REFERENCE_COLOR, ls=":", lw=1.4)
     if collision is None:
         return {}
     meta = collision.iloc[0]

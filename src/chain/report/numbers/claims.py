@@ -179,14 +179,8 @@ def dissipation_pairs(summary):
 def dissipation_verdicts(summary) -> list[dict]:
     """C of each dissipative model over C of each conservative one (chains pooled, main
     estimator), and whether the ratio is 1 within ``TOLERANCES["dissipation_ratio"]``:
-    the paper's "dissipation does not change Δ" (Sec. V), decided here only.
-
-    Returns
-    -------
-    list of dict
-        ``model``, ``base`` (the conservative model), ``ratio`` (C / C_base) and
-        ``agrees`` (bool), per pair of :func:`dissipation_pairs`.
-    """
+    the paper's "dissipation does not change Δ" (Sec. V), decided here only. One
+    ``{model, base, ratio, agrees}`` per pair of :func:`dissipation_pairs`."""
     out = []
     for model, base, row, reference in dissipation_pairs(summary):
         ratio = row["C_us_N16"] / reference["C_us_N16"]
@@ -233,7 +227,9 @@ def _drift_claim(summary) -> list[dict]:
 
 
 def claims(summary: Mapping, delays=None, ssw=None) -> list[dict]:
-    """The claim-by-claim table: claim | paper | ours | agrees | why not.
+    """The claim-by-claim table, rows of ``claim``, ``paper`` (the paper's number or
+    statement), ``ours``, ``agrees`` ("yes", "no" or "not testable", against
+    :data:`chain.report.numbers.claim_rows.TOLERANCES`) and ``why`` (not).
 
     Parameters
     ----------
@@ -241,13 +237,6 @@ def claims(summary: Mapping, delays=None, ssw=None) -> list[dict]:
         The run's ``summary.json``.
     delays, ssw : DataFrame, optional
         ``delays.csv`` (the sign of Δ) and ``ssw.csv`` (the SSW exponent against F_m).
-
-    Returns
-    -------
-    list of dict
-        Keys ``claim``, ``paper`` (the paper's number or statement), ``ours``,
-        ``agrees`` ("yes", "no" or "not testable", from
-        :data:`chain.report.numbers.claim_rows.TOLERANCES`), ``why``.
     """
     return [
         *_early_claim(summary, delays),

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 import pandas as pd
 
 #: A ratio to the frictionless (or candidate-off) value that counts as "significantly
-#: larger" (issue 24).
+#: larger" (the verdict and the mechanism figure's dotted mark).
 SIGNIFICANT_RATIO = 2.0
 
 
@@ -64,15 +64,10 @@ def friction_sentence(table: pd.DataFrame, mechanism: str) -> str:
 
 
 def friction_c_rows(table: pd.DataFrame, mechanism: str) -> list[dict]:
-    """C with track and bead friction beside the frictionless C, per chain and setting.
-
-    Returns
-    -------
-    list of dict
-        ``N``, ``setting``, ``C_frictionless`` and ``C`` (µs N^(1/6), None where not
-        fitted), for each frictional row of ``mechanism`` (the first setting of a
-        mechanism is its frictionless reference, as in :func:`friction_sentence`).
-    """
+    """C with track and bead friction beside the frictionless C, per chain and setting:
+    ``N``, ``setting``, ``C_frictionless`` and ``C`` (µs N^(1/6), None where not fitted)
+    of each frictional row of ``mechanism`` (the first setting of a mechanism is its
+    frictionless reference, as in :func:`friction_sentence`)."""
     rows = table[table["mechanism"] == mechanism]
     if rows.empty:
         return []
@@ -159,11 +154,7 @@ def _contrast(rows: pd.DataFrame) -> str:
 
 
 def mechanism_summary(
-    table: pd.DataFrame,
-    check: pd.DataFrame | None,
-    *,
-    friction: str,
-    reference: str,
+    table: pd.DataFrame, check: pd.DataFrame | None, *, friction: str, reference: str
 ) -> dict:
     """``{"verdict": two sentences, "rows": the table, "lammps_check": its rows,
     "friction_C": C with and without friction}`` (:func:`friction_c_rows`).

@@ -1,16 +1,15 @@
-"""The run's headline numbers beside the paper's: ``summary.json`` and ``summary.md``.
+"""The run's headline numbers beside the paper's: ``summary.json``.
 
 Every number is computed from the run's tables and the closed forms of
 :mod:`chain.physics.theory`, except the paper's own values in :data:`PAPER`, quoted as
-printed. :func:`build_summary` gathers them into a JSON-ready dict, :func:`summary_json`
-writes it with sorted keys and fixed float formatting, and :func:`write_summary_json`
-writes ``summary.json`` atomically; :mod:`chain.report.text.markdown` writes the Markdown from it.
+printed. :func:`build_summary` gathers them into a JSON-ready dict and
+:func:`write_summary_json` writes it; :mod:`chain.report.text.markdown` writes
+``summary.md`` from it.
 """
 
 from __future__ import annotations
 
 import json
-import logging
 import math
 import os
 from collections.abc import Iterable, Mapping
@@ -37,8 +36,6 @@ from chain.report.numbers.paper import PAPER, PAPER_BEADS
 
 #: Significant digits of floats in summary.json.
 JSON_DIGITS = 10
-
-log = logging.getLogger(__name__)
 
 
 def _number(value):
@@ -129,15 +126,14 @@ def build_summary(
     Returns
     -------
     dict
-        ``run_name``, ``material``, ``radius_m``, ``main_estimator``,
-        ``conservative_models``, ``constants``,
-        ``paper``, ``max_energy_drift`` (largest relative drift of the conservative
-        runs, None without any), ``energy_drift_by_model``, ``delay_fits`` and
-        ``ssw_fits`` (the rows of the tables), ``flagged`` (per table and source:
-        ``rows``, ``flagged`` = ok False, ``nan`` = ok but a NaN value; ssw counts the
-        ``residual`` rows, the ones fitted and drawn), ``selection`` (kept/rejected
-        shots per series, N and kind), ``experiment_tolerance``, and the SSW keys of
-        :func:`ssw_summary`.
+        The arguments' plain values, ``constants``, ``paper``, ``max_energy_drift``
+        (largest relative drift of the conservative runs, None without any),
+        ``energy_drift_by_model``, ``delay_fits`` and ``ssw_fits`` (the rows of the
+        tables), ``flagged`` (per table and source: ``rows``, ``flagged`` = ok False,
+        ``nan`` = ok but a NaN value; ssw counts the ``residual`` rows, the ones
+        fitted and drawn), ``selection`` (kept/rejected shots per series, N and kind),
+        ``experiment_tolerance``, ``attenuation``, the SSW keys of :func:`ssw_summary`
+        and :func:`decisions`.
     """
     conservative = set(conservative_models)
     drift_by_model = {}
@@ -224,16 +220,8 @@ def decisions(summary: Mapping) -> dict:
 def ssw_summary(
     ssw: pd.DataFrame | None, ssw_fits: pd.DataFrame, ssw_speed: pd.DataFrame | None
 ) -> dict:
-    """The SSW keys of ``summary.json``.
-
-    Parameters
-    ----------
-    ssw : DataFrame or None
-        ``ssw.csv``.
-    ssw_fits : DataFrame
-        ``ssw_fits.csv``.
-    ssw_speed : DataFrame or None
-        ``ssw_speed.csv``.
+    """The SSW keys of ``summary.json`` from ``ssw.csv``, ``ssw_fits.csv`` and
+    ``ssw_speed.csv`` (``ssw`` and ``ssw_speed`` None when the run has none).
 
     Returns
     -------
@@ -322,15 +310,7 @@ def _residual_rows(ssw: pd.DataFrame | None) -> pd.DataFrame | None:
 
 
 def write_summary_json(summary: Mapping, json_path: str | os.PathLike) -> None:
-    """Write ``summary.json`` atomically (temporary name, then rename), sorted keys and
-    floats to :data:`JSON_DIGITS` digits; ``summary.md`` is written from it by
-    :func:`chain.report.text.markdown.write_summary_markdown`.
-
-    Parameters
-    ----------
-    summary : mapping
-        The dict of :func:`build_summary`.
-    json_path : path
-        Destination.
-    """
+    """Write ``summary`` (:func:`build_summary`) to ``json_path`` atomically, as
+    :func:`summary_json`; ``summary.md`` is written from it by
+    :func:`chain.report.text.markdown.write_summary_markdown`."""
     write_text_atomic(summary_json(summary), json_path)

@@ -2,14 +2,11 @@
 
 The article's text lives in a typst source (``workflow/report/article.typ``); every
 number in it comes from here. :func:`article_numbers` turns the run's ``summary.json``
-(and its delay and SSW tables) into one JSON-ready dict of strings, each number already
-rounded as the article prints it, the claim-by-claim table with its verdicts computed
-against the tolerances of :data:`TOLERANCES`, and the findings of the SSW and ablation
-studies (``None`` when the run did not compute them: the article then says so).
-:func:`compile_article` compiles the source with the ``typst`` package from PyPI.
-
-The paper's own numbers come from :mod:`chain.report.numbers.paper` via ``summary["paper"]``
-and are always printed as the paper's.
+into one JSON-ready dict of strings, each number already rounded as the article prints
+it, with the claim table as the summary decided it and the studies' findings (``None``
+when the run did not compute them: the article then says so); the paper's own numbers
+are always printed as the paper's. :func:`compile_article` compiles the source with the
+``typst`` package from PyPI.
 """
 
 from __future__ import annotations
@@ -337,9 +334,7 @@ def setup_text(setup: Mapping | None) -> dict:
 
 
 def article_numbers(
-    summary: Mapping,
-    setup: Mapping | None = None,
-    provenance: Mapping | None = None,
+    summary: Mapping, setup: Mapping | None = None, provenance: Mapping | None = None
 ) -> dict:
     """Everything the article prints, as strings: the JSON that article.typ reads.
 

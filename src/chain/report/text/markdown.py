@@ -29,13 +29,8 @@ from chain.report.text.markdown_studies import mechanism_markdown, spread_markdo
 
 
 def summary_markdown(summary: Mapping) -> str:
-    """The side-by-side table of ``summary.md``: quantity | paper | this run | note.
-
-    Parameters
-    ----------
-    summary : mapping
-        The dict of :func:`chain.report.numbers.summary.build_summary`.
-    """
+    """The side-by-side table of ``summary.md``: quantity | paper | this run | note, of
+    ``summary`` (the dict of :func:`chain.report.numbers.summary.build_summary`)."""
     main = summary["main_estimator"]
     label = summary.get("experiment_label", "experiment")
     fits = _sorted_fits(summary["delay_fits"], main)

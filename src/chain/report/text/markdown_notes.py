@@ -1,8 +1,7 @@
 """The notes under ``summary.md``'s table: how Δ and the SSW are measured, what the
 paper says about friction and dissipation, and what the SSW rows show. A note that
 cites a number of the run takes it from ``summary.json``; a note without the number in
-the summary leaves the sentence out.
-"""
+the summary leaves the sentence out."""
 
 from __future__ import annotations
 
@@ -39,13 +38,7 @@ FIXED_NOTES = [
 
 
 def notes(summary: Mapping) -> list[str]:
-    """The notes of ``summary.md``, as Markdown list items.
-
-    Parameters
-    ----------
-    summary : mapping
-        The run's ``summary.json``.
-    """
+    """The notes of ``summary.md`` for the run's ``summary.json``, as Markdown list items."""
     return [*FIXED_NOTES, _ssw_note(summary), *_attenuation_notes(summary)]
 
 

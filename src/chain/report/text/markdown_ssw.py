@@ -2,8 +2,7 @@
 sensors, whether it is resolved there, where it separates along the chain and its
 speed, and the even / odd ratios. Wording only: every number is a key of
 ``summary.json`` (``ssw_fits``, ``ssw_resolved``, ``ssw_separation``,
-``ssw_parity_ratio``, ``ssw_far_field``).
-"""
+``ssw_parity_ratio``, ``ssw_far_field``)."""
 
 from __future__ import annotations
 
@@ -17,13 +16,7 @@ Row = tuple[str, str, str, str]
 
 
 def ssw_rows(summary: Mapping) -> list[Row]:
-    """Every SSW row of ``summary.md``, in the table's order.
-
-    Parameters
-    ----------
-    summary : mapping
-        The run's ``summary.json``.
-    """
+    """Every SSW row of ``summary.md`` for the run's ``summary.json``, in the table's order."""
     return (
         _slope_rows(summary)
         + _resolved_rows(summary)

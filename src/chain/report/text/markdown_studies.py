@@ -2,8 +2,7 @@
 experiment, the spread of C over our choices (summary keys ``ablation`` and
 ``c_spread``) and the mechanism study (``ssw_mechanisms``), or that the config switched
 a study off (``studies_not_run``). Wording only: the verdicts are the summary's
-(:mod:`chain.report.numbers.spread`, :mod:`chain.report.numbers.mechanisms`).
-"""
+(:mod:`chain.report.numbers.spread`, :mod:`chain.report.numbers.mechanisms`)."""
 
 from __future__ import annotations
 
