@@ -1,17 +1,10 @@
-"""The experiment's part of the plan: its traces, virtual or measured, in the trace
-format, and the paper's acceptance protocol on them.
-
-* ``experiment.source: virtual``: ``virtual_experiment`` (one job per chain) writes a
-  dataset in the measured format to ``experiment/raw/N<N>/`` (a MODEL of the apparatus,
-  labelled "virtual experiment (model)");
-* ``experiment.source: measured``: the dataset folders of ``experiment.datasets`` are
-  read instead (their N and sensors from their ``metadata.yaml``);
-* ``experiment.source: none``: nothing here runs, and Fig. 2 is not drawn.
-
-Then ``experiment_traces`` loads the datasets into ``experiment/<name>_N<N>_traces.csv``,
-which the pulse table analyses with the simulated traces, and ``selection`` applies
-the 5 % amplitude match (``experiment/selection.csv``), which the delay and SSW tables
-use to drop rejected collision shots.
+"""The experiment's part of the plan: its traces in the trace format, and the paper's
+acceptance protocol on them. With ``experiment.source: virtual``, ``virtual_experiment``
+writes each chain's dataset in the measured format (a MODEL of the apparatus); with
+``measured``, the datasets of ``experiment.datasets`` are read instead; with ``none``
+nothing here runs and Fig. 2 is not drawn. ``experiment_traces`` loads the datasets,
+``selection`` applies the 5 % amplitude match (``experiment/selection.csv``), which the
+delay and SSW tables use to drop rejected collision shots.
 """
 
 from __future__ import annotations

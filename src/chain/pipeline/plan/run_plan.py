@@ -1,18 +1,12 @@
 """The run plan: what a checked config means for the run, derived once.
 
-The Snakefile validates the config against its schema (which fills in every default)
-and checks it (:func:`chain.pipeline.config.check.check_config`); ``common.smk`` then
-makes ONE :class:`RunPlan` of it. The plan holds the facts every part shares (models,
-chains, launch speeds, durations) and composes the parts of the run, each planning
-itself beside its own concern: the simulation, the experiment, the analysis, the
-figures, the report (:data:`CORE_PARTS`) and each study the schema names under
-``studies``. Each part gives its steps (the rules, :mod:`.steps`) and its files of the
-default run; the plan joins them into every job of the run (:attr:`RunPlan.jobs`) and
-the targets.
-
-It reads no file but the measured datasets' ``metadata.yaml`` (when first asked) and
-knows no Snakemake; making one is cheap (LAMMPS is imported when the mechanism study
-first asks whether it is installed).
+``common.smk`` makes ONE :class:`RunPlan` of the config after its schema (which fills in
+every default) and :func:`chain.pipeline.config.check.check_config`. The plan holds the
+facts every part shares (models, chains, launch speeds, durations) and composes the
+parts of the run, each planning itself (:data:`CORE_PARTS` and each study the schema
+names under ``studies``): their steps make every job of the run (:attr:`RunPlan.jobs`),
+their files the targets. It reads no file but the measured datasets' metadata, and
+knows no Snakemake.
 """
 
 from __future__ import annotations

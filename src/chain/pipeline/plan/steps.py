@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
-#: Scheduling a step asks for when it says nothing: one core, Snakemake's priority 0.
+#: A job's cores or priority: a number, or a function of its wildcards.
 Needs = Callable[[Mapping[str, str]], int] | int
 
 

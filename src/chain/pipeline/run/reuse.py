@@ -1,23 +1,13 @@
-"""Reuse across runs, decided in Snakemake's process before the first job.
+"""Reuse across runs, decided in Snakemake's process before the first job
+(``docs/architecture.md``, "How a run decides what to compute").
 
 Every job of the plan (:mod:`chain.pipeline.plan.steps`) has a key: the SHA-256 of its
-recipe, that is its rule, wildcards and parameters, where its outputs go inside the run
-folder, the versions of Python and the packages that compute (:data:`REUSE_PACKAGES`),
-and for each input either the SHA-256 of its bytes (a file no job makes: code, a
-measured dataset, the article's source) or the key of the job that makes it. Keys are
-known before any job runs, down the whole chain of recipes.
-
-:meth:`Reuse.prepare` runs while Snakemake builds its DAG, before it decides what must
-run: each job of the run whose outputs the run folder lacks, and whose key the store
-holds, gets its stored files copied into the run folder, each checked against the
-SHA-256 recorded when it was stored; Snakemake then finds them there and starts no job
-for them (no process here, no batch job on a cluster). A dry run copies nothing: it
-checks the entries and points the jobs that read them at the store, so that Snakemake
-lists exactly the jobs that compute. A damaged entry is named on the console and its
-job computes. What the run computed is stored when it ends (:meth:`Reuse.finish`),
-which also writes the run folder's ``SHA256SUMS`` once every target has succeeded.
-``--forceall`` (``-F``, ``-R``) takes nothing from the store and replaces what it
-stored; ``reuse: false`` neither reads nor writes the store.
+recipe (rule, wildcards, parameters, its outputs' places in the run folder, the versions
+of :data:`REUSE_PACKAGES`, and per input the SHA-256 of a file no job makes or the key
+of the job that makes it), known before any job runs. :meth:`Reuse.prepare` copies the
+stored results the run folder lacks into it, checked, as Snakemake builds its DAG (a dry
+run points the jobs at the store instead), so that no job starts for them;
+:meth:`Reuse.finish` stores what the run computed and certifies a run that succeeded.
 """
 
 from __future__ import annotations

@@ -1,27 +1,15 @@
 """Two defects of Snakemake's scheduler that a run of this workflow meets, patched from
-the Snakefile until Snakemake fixes them; each is written up with a reproducer that
-needs no part of this workflow in ``docs/upstream/`` (``docs/upstream/README.md``).
+the Snakefile until Snakemake fixes them; each is written up, with a reproducer that
+needs no part of this workflow, in ``docs/upstream/README.md``:
 
-* **Wake-ups multiply** (:func:`coalesce_wakeups`). ``JobScheduler`` ends each pass of
-  its loop in which jobs were ready with a ``threading.Timer`` that wakes the loop
-  after the job rate limiter's timespan; the pass such a timer wakes starts another,
-  and every job that starts or ends adds a pass, so the timers multiply. The tiny test
-  config's 53 jobs made 1687 passes, each re-reading the size of every ready job's
-  inputs and solving the job selection again: 10.3 s of Snakemake's CPU, 4.5 s with
-  one pending wake-up (snakemake/snakemake#3804: with 10 000 jobs it runs out of
-  threads). The timers are not daemons, so the process also waits up to a second for
-  them after its last job.
-* **SIGTERM hangs the run** (:func:`stop_gracefully_off_the_main_thread`). The SIGTERM
-  handler ``exit_gracefully`` takes the scheduler's lock (not reentrant); Python runs
-  the handler in the main thread, which holds that lock while it selects jobs. A
-  SIGTERM in that window (``kill PID``; a batch system's cancel) makes the main thread
-  wait for itself, for good.
+* **wake-ups multiply** (:func:`coalesce_wakeups`): every pass of the scheduling loop
+  with ready jobs starts a timer that starts another pass (snakemake/snakemake#3804);
+* **SIGTERM hangs the run** (:func:`stop_gracefully_off_the_main_thread`): the handler
+  waits for the lock the main thread holds while it selects jobs.
 
-The patches replace private methods of Snakemake's scheduler, so they are applied only
-on the release they were written for (:data:`WRITTEN_FOR`, the locks' release); on any
-other, :func:`patch_snakemake` leaves Snakemake as it is and says so in one line.
-``tests/test_snakemake_patches.py`` fails when they no longer apply to the locked
-Snakemake.
+The patches replace private methods of the scheduler, so they are applied only on the
+release they were written for (:data:`WRITTEN_FOR`, the locks'); on any other
+:func:`patch_snakemake` leaves Snakemake as it is and says so in one line.
 """
 
 from __future__ import annotations
@@ -51,16 +39,9 @@ def coalesce_wakeups(scheduler_class) -> bool:
     wake-up timer per scheduler, a daemon thread. While jobs wait, a pass still comes
     once per timespan, which is all the rate limiter needs; the selection is unchanged.
 
-    Parameters
-    ----------
-    scheduler_class : type
-        The class whose ``_schedule_reevalutation(self, delay)`` (delay in s) starts a
-        timer that releases ``self._open_jobs``.
-
-    Returns
-    -------
-    bool
-        Whether it was changed (False: no such method, left as it is).
+    ``scheduler_class``'s ``_schedule_reevalutation(self, delay)`` (delay in s) starts
+    a timer that releases ``self._open_jobs``. Returns whether it was changed (False: no
+    such method, left as it is).
     """
     original = getattr(scheduler_class, WAKEUP_METHOD, None)
     if not callable(original):
@@ -90,17 +71,8 @@ def stop_gracefully_off_the_main_thread(scheduler_class) -> bool:
     waits for the lock as the executor's callback threads do; the main thread finishes
     its pass, and the stop proceeds as Snakemake means it to (no new job, the running
     ones finish, exit 1). Call it before the scheduler is made (it installs the handler
-    as it starts).
-
-    Parameters
-    ----------
-    scheduler_class : type
-        The class whose ``exit_gracefully(self, *args)`` is the SIGTERM handler.
-
-    Returns
-    -------
-    bool
-        Whether the handler now runs off the main thread (False: no such method).
+    as it starts). ``scheduler_class``'s ``exit_gracefully(self, *args)`` is the SIGTERM
+    handler; returns whether it now runs off the main thread (False: no such method).
     """
     handler = getattr(scheduler_class, SIGTERM_METHOD, None)
     if not callable(handler) or getattr(handler, "_off_the_main_thread", False):
