@@ -272,6 +272,78 @@ def built_once(tmp_path_factory) -> Callable[[str, Callable[[Path], None]], Path
     return once
 
 
+# ---- the step loop compiled cold, once -------------------------------------------------
+
+#: One job on a node: imports, says so, waits for the go, simulates the paper's
+#: collision on a short chain, reports how numba got the step loop (compiled: a cache
+#: miss; loaded: a hit) and a digest of the forces. The job that compiled it (every
+#: callee too, in this process) also reports the versions numba made, then runs a long
+#: chain launched from one end (chain.physics.at_rest skips its far beads, calling the
+#: step loop from Python on parts of the chain) and reports them again.
+COLD_JOB = """\
+import hashlib, json, sys
+from chain.physics import kernels
+from chain.physics.builders import uniform_chain
+from chain.physics.simulation import simulate
+print("ready", flush=True)
+sys.stdin.readline()
+result = simulate(uniform_chain(8), 0.3, 0.3, duration=2e-4)
+stats = kernels._integrate_part.stats
+report = {
+    "misses": sum(stats.cache_misses.values()),
+    "hits": sum(stats.cache_hits.values()),
+    "digest": hashlib.sha256(result.contact_force.tobytes()).hexdigest(),
+}
+if report["misses"]:
+    report["whole"] = sorted(map(str, kernels._integrate_part.signatures))
+    report["records"] = sorted(map(str, kernels._record.overloads))
+    simulate(uniform_chain(400), [0.5], [0.0], duration=2e-4)
+    report["after_at_rest"] = sorted(map(str, kernels._integrate_part.signatures))
+print(json.dumps(report), flush=True)
+"""
+
+
+@pytest.fixture(scope="session")
+def cold_step_loop_jobs(built_once) -> tuple[list[dict], Path]:
+    """Three jobs (:data:`COLD_JOB`) started together on a node whose numba cache
+    (NUMBA_CACHE_DIR, empty) lacks the step loop, let go only once all three have
+    imported the library: (their reports, the cache folder). Run once per session,
+    for the tests of tests/test_compile_once.py (one job compiles, the others wait
+    and load) and tests/test_kernels.py (what the compiling job's numba made), which
+    would otherwise each compile the step loop cold in a process of their own."""
+    import json
+    import subprocess
+    import sys
+
+    def build(folder: Path) -> None:
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(folder / "numba")}
+        jobs = [
+            subprocess.Popen(
+                [sys.executable, "-c", COLD_JOB],
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+                env=env,
+            )
+            for _ in range(3)
+        ]
+        for job in jobs:
+            assert job.stdout.readline().strip() == "ready", job.stderr.read()
+        for job in jobs:
+            job.stdin.write("go\n")
+            job.stdin.flush()
+        reports = []
+        for job in jobs:
+            out, err = job.communicate(timeout=900)
+            assert job.returncode == 0, err[-3000:]
+            reports.append(json.loads(out.splitlines()[-1]))
+        (folder / "reports.json").write_text(json.dumps(reports))
+
+    folder = built_once("cold-step-loop", build)
+    return json.loads((folder / "reports.json").read_text()), folder / "numba"
+
+
 # ---- the library in a workflow run's own folder -----------------------------------------
 
 
