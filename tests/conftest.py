@@ -198,8 +198,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     first test of each shared workflow run (:func:`built_once`) goes at positions 0, 2,
     4, ..., each followed by a short test: every worker starts by building a different
     run, rather than wait for another's. Then the other tests marked ``workflow``
-    (Snakemake runs, the longest), then the rest, which fill the end. Otherwise the
-    collection order.
+    (Snakemake runs, the longest), then the rest, which fill the end (those that
+    compile numba's kernels first, once the tests not selected are left out:
+    :class:`_CompilingFirst`). Otherwise the collection order.
     """
     runs = {item: _shared_run(item) for item in items}
     builders = list({run: item for item in reversed(items) if (run := runs[item])}.values())
@@ -210,6 +211,43 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     workflow = [i for i in items if i not in chosen and i.get_closest_marker("workflow")]
     chosen.update(workflow)
     items[:] = first + workflow + [i for i in items if i not in chosen]
+
+
+class _CompilingFirst:
+    """After the tests not selected are left out (``-m``, ``-k``: pytest's own hook),
+    the tests after the last one marked ``workflow`` (all of them in a run without the
+    workflow tests) begin with those that compile numba's kernels
+    (:func:`_compiling_first`). The order of the workflow tests stays as
+    :func:`pytest_collection_modifyitems` made it."""
+
+    @pytest.hookimpl(trylast=True)
+    def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
+        marked = [n for n, item in enumerate(items) if item.get_closest_marker("workflow")]
+        start = marked[-1] + 1 if marked else 0
+        items[start:] = _compiling_first(items[start:])
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.pluginmanager.register(_CompilingFirst(), "hertzchain-compiling-first")
+
+
+def _compiling_first(items: list[pytest.Item]) -> list[pytest.Item]:
+    """``items`` with the tests that compile numba's kernels first, each followed by
+    another test (xdist gives each worker two tests to start with): the one that runs
+    :func:`cold_step_loop_jobs`, then one test of :func:`unit_test_kernels` per worker.
+    On a fresh checkout each worker then starts compiling: one the step loop cold, the
+    others a turn of the kernels each, side by side, where they used to compile each
+    kernel when a test first ran it, the other worker waiting for it when it ran the
+    same kind. With the kernels in numba's cache, only the order changes."""
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    cold = [i for i in items if "cold_step_loop_jobs" in i.fixturenames]
+    turns = [i for i in items if "unit_test_kernels" in i.fixturenames and i not in cold]
+    starters = cold[:1] + turns[:workers]
+    others = [i for i in items if i not in starters]
+    ordered = []
+    for n, starter in enumerate(starters):
+        ordered += [starter, *others[n : n + 1]]
+    return ordered + others[len(starters) :]
 
 
 def _shared_run(item: pytest.Item) -> str | None:
@@ -303,14 +341,21 @@ print(json.dumps(report), flush=True)
 """
 
 
+#: The folder of :func:`cold_step_loop_jobs`' run, and the name of its lock.
+COLD_STEP_LOOP = "cold-step-loop"
+
+
 @pytest.fixture(scope="session")
-def cold_step_loop_jobs(built_once) -> tuple[list[dict], Path]:
+def cold_step_loop_jobs(request) -> tuple[list[dict], Path]:
     """Three jobs (:data:`COLD_JOB`) started together on a node whose numba cache
     (NUMBA_CACHE_DIR, empty) lacks the step loop, let go only once all three have
-    imported the library: (their reports, the cache folder). Run once per session,
-    for the tests of tests/test_compile_once.py (one job compiles, the others wait
-    and load) and tests/test_kernels.py (what the compiling job's numba made), which
-    would otherwise each compile the step loop cold in a process of their own."""
+    imported the library: (their reports, the cache folder). Run once per session
+    (:func:`built_once`), for the tests of tests/test_compile_once.py (one job
+    compiles, the others wait and load) and tests/test_kernels.py (what the compiling
+    job's numba made), which would otherwise each compile the step loop cold in a
+    process of their own. :func:`built_once` is asked for here, not as an argument:
+    :func:`pytest_collection_modifyitems` orders the tests of a workflow run by their
+    arguments, and places these itself."""
     import json
     import subprocess
     import sys
@@ -340,7 +385,7 @@ def cold_step_loop_jobs(built_once) -> tuple[list[dict], Path]:
             reports.append(json.loads(out.splitlines()[-1]))
         (folder / "reports.json").write_text(json.dumps(reports))
 
-    folder = built_once("cold-step-loop", build)
+    folder = request.getfixturevalue("built_once")(COLD_STEP_LOOP, build)
     return json.loads((folder / "reports.json").read_text()), folder / "numba"
 
 
@@ -411,9 +456,10 @@ def compiled_kernels(tmp_path_factory) -> None:
 
 @pytest.fixture(scope="session")
 def unit_test_kernels(request, tmp_path_factory) -> None:
-    """The kernels that the unit tests of the integrator run beyond the workflow's
-    (walls, track drag, the reference kernel), compiled in turns by the xdist workers
-    (:func:`_compile_in_turns`) when the first of those tests starts in each.
+    """The kernels that the unit tests of the integrator run: the workflow's and those
+    with walls or track drag and the reference kernel, compiled in turns by the xdist
+    workers (:func:`_compile_in_turns`) when the first of those tests starts in each
+    (one per worker, first of all: :func:`_compiling_first`).
 
     Without it, two workers that reached the kernel tests together met on the same
     version: one compiled it, the other waited for it with its core idle (twice ~7 s at
@@ -421,11 +467,12 @@ def unit_test_kernels(request, tmp_path_factory) -> None:
     54.6-57.5 s before, 48.2-52.0 s with it). Only where it pays: with more than one
     worker and a session that runs more of these tests than twice the kernels. A
     serial run, or a few tests picked (after an edit of the kernels, whose cache it
-    empties), compile what they run: one or two kernels, not four."""
+    empties), compile what they run: one or two kernels, not six."""
     users = sum("unit_test_kernels" in item.fixturenames for item in request.session.items)
     workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
-    if workers > 1 and users > 2 * len(_UNIT_TEST_KERNELS):
-        _compile_in_turns(_shared_folder(tmp_path_factory), _UNIT_TEST_KERNELS, wait=False)
+    kinds = _KERNEL_KINDS + _UNIT_TEST_KERNELS
+    if workers > 1 and users > 2 * len(kinds):
+        _compile_in_turns(_shared_folder(tmp_path_factory), kinds, wait=False)
 
 
 def _compile_in_turns(shared: Path, kinds: tuple, *, wait: bool = True) -> None:
@@ -463,9 +510,9 @@ def _compile_in_turns(shared: Path, kinds: tuple, *, wait: bool = True) -> None:
 _KERNEL_KINDS = (("elastic", {}, "lean"), ("damped", {"eta": PAPER_ETA}, "lean"))
 
 #: What the unit tests of tests/test_integrator.py and tests/test_kernels.py compile
-#: beyond :data:`_KERNEL_KINDS`: the general kernel, and the lean kernel of a chain with
-#: walls, damped or not, and of one with track drag (worker gw0 starts with the first,
-#: gw1 with the second: the first test of tests/test_integrator.py runs it).
+#: beyond :data:`_KERNEL_KINDS` (which they run too, as most other tests do): the
+#: general kernel, and the lean kernel of a chain with walls, damped or not, and of one
+#: with track drag.
 _UNIT_TEST_KERNELS = (
     ("reference", {"eta": PAPER_ETA, "right_wall": True}, "reference"),
     ("walls-damped", {"eta": PAPER_ETA, "right_wall": True}, "lean"),
