@@ -163,6 +163,47 @@ def release_time():
     return hertz_release_time
 
 
+# ---- the config schema, parsed once ----------------------------------------------------
+
+
+@pytest.fixture(scope="session", autouse=True)
+def schema_parsed_once() -> Iterator[None]:
+    """snakemake.utils.validate, which the tests call as the Snakefile does, reads and
+    parses its schema file at every call (YAML through yte: ~40 ms for the config
+    schema), and the tests validate some 200 configs (~8 s of CPU a session). Here
+    snakemake's loader parses each schema file once per process and gives validate a
+    copy of it while the file is unchanged (path, size, modification time): every
+    config is checked by the same code against the same schema. Only where a test
+    module has imported snakemake.utils already (at collection), so that a session
+    without them does not import Snakemake for this; loads other than a schema file's
+    go through untouched."""
+    import copy
+    import sys
+
+    utils = sys.modules.get("snakemake.utils")
+    load = getattr(utils, "_load_configfile", None)
+    if load is None:
+        yield
+        return
+    parsed = {}
+
+    def load_schema_once(source, filetype="Config"):
+        if filetype != "Schema" or not isinstance(source, str | os.PathLike):
+            return load(source, filetype=filetype)
+        try:
+            stat = Path(source).stat()
+        except OSError:  # snakemake's own error
+            return load(source, filetype=filetype)
+        key = (str(Path(source).resolve()), stat.st_size, stat.st_mtime_ns)
+        if key not in parsed:
+            parsed[key] = load(source, filetype=filetype)
+        return copy.deepcopy(parsed[key])
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(utils, "_load_configfile", load_schema_once)
+        yield
+
+
 # ---- the suite on every core (pytest-xdist) -------------------------------------------
 
 #: The checkout (its Snakefile, workflow/ and src/).
