@@ -163,6 +163,47 @@ def release_time():
     return hertz_release_time
 
 
+# ---- the config schema, parsed once ----------------------------------------------------
+
+
+@pytest.fixture(scope="session", autouse=True)
+def schema_parsed_once() -> Iterator[None]:
+    """snakemake.utils.validate, which the tests call as the Snakefile does, reads and
+    parses its schema file at every call (YAML through yte: ~40 ms for the config
+    schema), and the tests validate some 200 configs (~8 s of CPU a session). Here
+    snakemake's loader parses each schema file once per process and gives validate a
+    copy of it while the file is unchanged (path, size, modification time): every
+    config is checked by the same code against the same schema. Only where a test
+    module has imported snakemake.utils already (at collection), so that a session
+    without them does not import Snakemake for this; loads other than a schema file's
+    go through untouched."""
+    import copy
+    import sys
+
+    utils = sys.modules.get("snakemake.utils")
+    load = getattr(utils, "_load_configfile", None)
+    if load is None:
+        yield
+        return
+    parsed = {}
+
+    def load_schema_once(source, filetype="Config"):
+        if filetype != "Schema" or not isinstance(source, str | os.PathLike):
+            return load(source, filetype=filetype)
+        try:
+            stat = Path(source).stat()
+        except OSError:  # snakemake's own error
+            return load(source, filetype=filetype)
+        key = (str(Path(source).resolve()), stat.st_size, stat.st_mtime_ns)
+        if key not in parsed:
+            parsed[key] = load(source, filetype=filetype)
+        return copy.deepcopy(parsed[key])
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(utils, "_load_configfile", load_schema_once)
+        yield
+
+
 # ---- the suite on every core (pytest-xdist) -------------------------------------------
 
 #: The checkout (its Snakefile, workflow/ and src/).
@@ -198,8 +239,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     first test of each shared workflow run (:func:`built_once`) goes at positions 0, 2,
     4, ..., each followed by a short test: every worker starts by building a different
     run, rather than wait for another's. Then the other tests marked ``workflow``
-    (Snakemake runs, the longest), then the rest, which fill the end. Otherwise the
-    collection order.
+    (Snakemake runs, the longest), then the rest, which fill the end (those that
+    compile numba's kernels first, once the tests not selected are left out:
+    :class:`_CompilingFirst`). Otherwise the collection order.
     """
     runs = {item: _shared_run(item) for item in items}
     builders = list({run: item for item in reversed(items) if (run := runs[item])}.values())
@@ -210,6 +252,43 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     workflow = [i for i in items if i not in chosen and i.get_closest_marker("workflow")]
     chosen.update(workflow)
     items[:] = first + workflow + [i for i in items if i not in chosen]
+
+
+class _CompilingFirst:
+    """After the tests not selected are left out (``-m``, ``-k``: pytest's own hook),
+    the tests after the last one marked ``workflow`` (all of them in a run without the
+    workflow tests) begin with those that compile numba's kernels
+    (:func:`_compiling_first`). The order of the workflow tests stays as
+    :func:`pytest_collection_modifyitems` made it."""
+
+    @pytest.hookimpl(trylast=True)
+    def pytest_collection_modifyitems(self, items: list[pytest.Item]) -> None:
+        marked = [n for n, item in enumerate(items) if item.get_closest_marker("workflow")]
+        start = marked[-1] + 1 if marked else 0
+        items[start:] = _compiling_first(items[start:])
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.pluginmanager.register(_CompilingFirst(), "hertzchain-compiling-first")
+
+
+def _compiling_first(items: list[pytest.Item]) -> list[pytest.Item]:
+    """``items`` with the tests that compile numba's kernels first, each followed by
+    another test (xdist gives each worker two tests to start with): the one that runs
+    :func:`cold_step_loop_jobs`, then one test of :func:`unit_test_kernels` per worker.
+    On a fresh checkout each worker then starts compiling: one the step loop cold, the
+    others a turn of the kernels each, side by side, where they used to compile each
+    kernel when a test first ran it, the other worker waiting for it when it ran the
+    same kind. With the kernels in numba's cache, only the order changes."""
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    cold = [i for i in items if "cold_step_loop_jobs" in i.fixturenames]
+    turns = [i for i in items if "unit_test_kernels" in i.fixturenames and i not in cold]
+    starters = cold[:1] + turns[:workers]
+    others = [i for i in items if i not in starters]
+    ordered = []
+    for n, starter in enumerate(starters):
+        ordered += [starter, *others[n : n + 1]]
+    return ordered + others[len(starters) :]
 
 
 def _shared_run(item: pytest.Item) -> str | None:
@@ -270,6 +349,85 @@ def built_once(tmp_path_factory) -> Callable[[str, Callable[[Path], None]], Path
         return folder
 
     return once
+
+
+# ---- the step loop compiled cold, once -------------------------------------------------
+
+#: One job on a node: imports, says so, waits for the go, simulates the paper's
+#: collision on a short chain, reports how numba got the step loop (compiled: a cache
+#: miss; loaded: a hit) and a digest of the forces. The job that compiled it (every
+#: callee too, in this process) also reports the versions numba made, then runs a long
+#: chain launched from one end (chain.physics.at_rest skips its far beads, calling the
+#: step loop from Python on parts of the chain) and reports them again.
+COLD_JOB = """\
+import hashlib, json, sys
+from chain.physics import kernels
+from chain.physics.builders import uniform_chain
+from chain.physics.simulation import simulate
+print("ready", flush=True)
+sys.stdin.readline()
+result = simulate(uniform_chain(8), 0.3, 0.3, duration=2e-4)
+stats = kernels._integrate_part.stats
+report = {
+    "misses": sum(stats.cache_misses.values()),
+    "hits": sum(stats.cache_hits.values()),
+    "digest": hashlib.sha256(result.contact_force.tobytes()).hexdigest(),
+}
+if report["misses"]:
+    report["whole"] = sorted(map(str, kernels._integrate_part.signatures))
+    report["records"] = sorted(map(str, kernels._record.overloads))
+    simulate(uniform_chain(400), [0.5], [0.0], duration=2e-4)
+    report["after_at_rest"] = sorted(map(str, kernels._integrate_part.signatures))
+print(json.dumps(report), flush=True)
+"""
+
+
+#: The folder of :func:`cold_step_loop_jobs`' run, and the name of its lock.
+COLD_STEP_LOOP = "cold-step-loop"
+
+
+@pytest.fixture(scope="session")
+def cold_step_loop_jobs(request) -> tuple[list[dict], Path]:
+    """Three jobs (:data:`COLD_JOB`) started together on a node whose numba cache
+    (NUMBA_CACHE_DIR, empty) lacks the step loop, let go only once all three have
+    imported the library: (their reports, the cache folder). Run once per session
+    (:func:`built_once`), for the tests of tests/test_compile_once.py (one job
+    compiles, the others wait and load) and tests/test_kernels.py (what the compiling
+    job's numba made), which would otherwise each compile the step loop cold in a
+    process of their own. :func:`built_once` is asked for here, not as an argument:
+    :func:`pytest_collection_modifyitems` orders the tests of a workflow run by their
+    arguments, and places these itself."""
+    import json
+    import subprocess
+    import sys
+
+    def build(folder: Path) -> None:
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(folder / "numba")}
+        jobs = [
+            subprocess.Popen(
+                [sys.executable, "-c", COLD_JOB],
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+                env=env,
+            )
+            for _ in range(3)
+        ]
+        for job in jobs:
+            assert job.stdout.readline().strip() == "ready", job.stderr.read()
+        for job in jobs:
+            job.stdin.write("go\n")
+            job.stdin.flush()
+        reports = []
+        for job in jobs:
+            out, err = job.communicate(timeout=900)
+            assert job.returncode == 0, err[-3000:]
+            reports.append(json.loads(out.splitlines()[-1]))
+        (folder / "reports.json").write_text(json.dumps(reports))
+
+    folder = request.getfixturevalue("built_once")(COLD_STEP_LOOP, build)
+    return json.loads((folder / "reports.json").read_text()), folder / "numba"
 
 
 # ---- the library in a workflow run's own folder -----------------------------------------
@@ -339,9 +497,10 @@ def compiled_kernels(tmp_path_factory) -> None:
 
 @pytest.fixture(scope="session")
 def unit_test_kernels(request, tmp_path_factory) -> None:
-    """The kernels that the unit tests of the integrator run beyond the workflow's
-    (walls, track drag, the reference kernel), compiled in turns by the xdist workers
-    (:func:`_compile_in_turns`) when the first of those tests starts in each.
+    """The kernels that the unit tests of the integrator run: the workflow's and those
+    with walls or track drag and the reference kernel, compiled in turns by the xdist
+    workers (:func:`_compile_in_turns`) when the first of those tests starts in each
+    (one per worker, first of all: :func:`_compiling_first`).
 
     Without it, two workers that reached the kernel tests together met on the same
     version: one compiled it, the other waited for it with its core idle (twice ~7 s at
@@ -349,11 +508,12 @@ def unit_test_kernels(request, tmp_path_factory) -> None:
     54.6-57.5 s before, 48.2-52.0 s with it). Only where it pays: with more than one
     worker and a session that runs more of these tests than twice the kernels. A
     serial run, or a few tests picked (after an edit of the kernels, whose cache it
-    empties), compile what they run: one or two kernels, not four."""
+    empties), compile what they run: one or two kernels, not six."""
     users = sum("unit_test_kernels" in item.fixturenames for item in request.session.items)
     workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
-    if workers > 1 and users > 2 * len(_UNIT_TEST_KERNELS):
-        _compile_in_turns(_shared_folder(tmp_path_factory), _UNIT_TEST_KERNELS, wait=False)
+    kinds = _KERNEL_KINDS + _UNIT_TEST_KERNELS
+    if workers > 1 and users > 2 * len(kinds):
+        _compile_in_turns(_shared_folder(tmp_path_factory), kinds, wait=False)
 
 
 def _compile_in_turns(shared: Path, kinds: tuple, *, wait: bool = True) -> None:
@@ -391,9 +551,9 @@ def _compile_in_turns(shared: Path, kinds: tuple, *, wait: bool = True) -> None:
 _KERNEL_KINDS = (("elastic", {}, "lean"), ("damped", {"eta": PAPER_ETA}, "lean"))
 
 #: What the unit tests of tests/test_integrator.py and tests/test_kernels.py compile
-#: beyond :data:`_KERNEL_KINDS`: the general kernel, and the lean kernel of a chain with
-#: walls, damped or not, and of one with track drag (worker gw0 starts with the first,
-#: gw1 with the second: the first test of tests/test_integrator.py runs it).
+#: beyond :data:`_KERNEL_KINDS` (which they run too, as most other tests do): the
+#: general kernel, and the lean kernel of a chain with walls, damped or not, and of one
+#: with track drag.
 _UNIT_TEST_KERNELS = (
     ("reference", {"eta": PAPER_ETA, "right_wall": True}, "reference"),
     ("walls-damped", {"eta": PAPER_ETA, "right_wall": True}, "lean"),

@@ -73,52 +73,16 @@ def test_a_kernel_without_cache_is_called_without_a_lock():
     assert len(add.overloads) == 1
 
 
-#: One job on a node: imports, says so, waits for the go, simulates the paper's
-#: collision on a short chain, reports how numba got the step loop (compiled: a cache
-#: miss; loaded: a hit) and a digest of the forces.
-JOB = """\
-import hashlib, sys
-from chain.physics import kernels
-from chain.physics.builders import uniform_chain
-from chain.physics.simulation import simulate
-print("ready", flush=True)
-sys.stdin.readline()
-result = simulate(uniform_chain(8), 0.3, 0.3, duration=2e-4)
-stats = kernels._integrate_part.stats
-digest = hashlib.sha256(result.contact_force.tobytes()).hexdigest()
-print(sum(stats.cache_misses.values()), sum(stats.cache_hits.values()), digest, flush=True)
-"""
-
-
-def test_jobs_on_a_node_with_an_empty_cache_compile_the_kernel_once(tmp_path):
+def test_jobs_on_a_node_with_an_empty_cache_compile_the_kernel_once(cold_step_loop_jobs):
     """Three jobs start together on a node whose numba cache (NUMBA_CACHE_DIR, empty)
     lacks the kernel: one compiles it, the two others wait for it and load it from
     the cache, and all three get the same bits. No clock: every job has imported the
     library before any of them is let go, and each waits on the lock, not a delay.
-    (Without chain.physics.compile_once all three compiled: three misses.)"""
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
-    jobs = [
-        subprocess.Popen(
-            [sys.executable, "-c", JOB],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-            env=env,
-        )
-        for _ in range(3)
-    ]
-    for job in jobs:
-        assert job.stdout.readline().strip() == "ready", job.stderr.read()
-    for job in jobs:
-        job.stdin.write("go\n")
-        job.stdin.flush()
-    reports = []
-    for job in jobs:
-        out, err = job.communicate(timeout=900)
-        assert job.returncode == 0, err[-3000:]
-        reports.append(out.split())
-    assert sorted(int(misses) for misses, _, _ in reports) == [0, 0, 1], reports
-    assert sorted(int(hits) for _, hits, _ in reports) == [0, 1, 1], reports
-    assert len({digest for _, _, digest in reports}) == 1
-    assert list((tmp_path / "numba").rglob("*_integrate_part*.nbi"))  # the cache is there
+    (Without chain.physics.compile_once all three compiled: three misses.) The jobs
+    are conftest.py's :func:`cold_step_loop_jobs`, run once for this test and one of
+    tests/test_kernels.py."""
+    reports, cache = cold_step_loop_jobs
+    assert sorted(report["misses"] for report in reports) == [0, 0, 1], reports
+    assert sorted(report["hits"] for report in reports) == [0, 1, 1], reports
+    assert len({report["digest"] for report in reports}) == 1
+    assert list(cache.rglob("*_integrate_part*.nbi"))  # the cache is there

@@ -220,47 +220,22 @@ def test_skipping_beads_at_rest_gives_the_reference_bits(name, monkeypatch):
     assert np.all(lean.refined_steps > 0)
 
 
-#: Run in a fresh interpreter whose numba cache is empty: a compile is what the test
-#: counts (kernels loaded from a cache leave the callee's signatures unrecorded).
-_SIGNATURES_OF_BOTH_PATHS = """
-import json
-from chain.physics.builders import uniform_chain
-from chain.physics.kernels import _integrate_part, _record
-from chain.physics.simulation import simulate
-
-simulate(uniform_chain(4), [0.1], [0.1], duration=1e-5)
-whole = sorted(map(str, _integrate_part.signatures))
-records = sorted(map(str, _record.overloads))
-# A launch from one end only: the far beads are at rest and skipped (at_rest).
-simulate(uniform_chain(400), [0.5], [0.0], duration=2e-4)
-print(json.dumps([whole, sorted(map(str, _integrate_part.signatures)), records]))
-"""
-
-
-def test_a_long_chain_runs_the_kernel_a_short_chain_compiled(tmp_path):
+def test_a_long_chain_runs_the_kernel_a_short_chain_compiled(cold_step_loop_jobs):
     """numba compiles the step loop (kernels._integrate_part) once per kind of model:
     the whole chain (_integrate_one) and chain.physics.at_rest call it from Python with
     the same types, never with literal constants, for which numba would compile the
     whole loop again (~13 s of a cold run, per kind); and the loop records every sample,
     the first one included, through one compiled _record (a literal 0 compiled it
-    twice). Compiled
-    cold, in a fresh interpreter (~20 s): with the kernels in numba's cache the callee's
-    signatures are not recorded, and the test would compare nothing."""
-    import json
-    import os
-    import subprocess
-    import sys
-
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}  # empty: everything compiles
-    done = subprocess.run(
-        [sys.executable, "-c", _SIGNATURES_OF_BOTH_PATHS],
-        capture_output=True,
-        text=True,
-        env=env,
-        check=False,
-    )
-    assert done.returncode == 0, done.stderr[-3000:]
-    whole, after_at_rest, records = json.loads(done.stdout.splitlines()[-1])
+    twice). Read off the job of conftest.py's :func:`cold_step_loop_jobs` that compiled
+    the loop, cold, in a fresh interpreter with an empty numba cache (~20 s; run once
+    for this test and one of tests/test_compile_once.py): with the kernels in numba's
+    cache the callee's signatures are not recorded, and the test would compare nothing.
+    It simulated a short chain (the whole chain), then a 400-bead one launched from one
+    end only, whose far beads at rest are skipped (at_rest)."""
+    reports, _ = cold_step_loop_jobs
+    compiled = [report for report in reports if report["misses"]]
+    assert compiled, reports  # one job compiled the loop (tests/test_compile_once.py)
+    whole, after_at_rest, records = (compiled[0][k] for k in ("whole", "after_at_rest", "records"))
     assert len(whole) == 1, whole  # the whole chain compiled the loop once
     assert after_at_rest == whole
     assert "Literal" not in whole[0], whole
