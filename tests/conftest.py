@@ -18,6 +18,8 @@ import contextlib
 import math
 import os
 import shutil
+import subprocess
+import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -270,6 +272,48 @@ def built_once(tmp_path_factory) -> Callable[[str, Callable[[Path], None]], Path
         return folder
 
     return once
+
+
+# ---- the tiny run: the workflow tests' one build --------------------------------------
+
+#: The workflow tests' config, overlaid on config.yaml: every rule on short chains.
+TINY_CONFIG = ROOT / "tests" / "configs" / "tiny.yaml"
+
+#: Not copied into the tiny run's checkout: caches and earlier results.
+_NOT_COPIED = shutil.ignore_patterns("__pycache__", "*.pyc", "results", ".snakemake")
+
+#: Longest the tiny run's build may take, s: a guard against a hang, far above its
+#: minutes on a machine shared with the other worker (pytest-xdist) or other work.
+_BUILD_TIMEOUT = 1800
+
+
+@pytest.fixture(scope="session")
+def tiny_run(built_once, copy_library) -> Path:
+    """The tiny run (:data:`TINY_CONFIG`), built from nothing with ``--cores 2`` once per
+    test session (:func:`built_once`) in a copy of the checkout: Snakefile, workflow/,
+    profiles/, config.yaml and the library in src/ (:func:`copy_library`), started
+    there as a user would: the copy's folder, its results in ``results/tiny/``.
+
+    test_workflow.py and test_reproducibility.py both inspect it; a test that changes
+    it (a rebuild, an edit, another run) works on a copy."""
+
+    def build(base: Path) -> None:
+        work = base / "checkout"
+        work.mkdir()
+        for name in ("config.yaml", "Snakefile"):
+            shutil.copy(ROOT / name, work / name)
+        for name in ("workflow", "profiles"):
+            shutil.copytree(ROOT / name, work / name, ignore=_NOT_COPIED)
+        env = copy_library(work / "src")
+        snakefile = ["--snakefile", str(work / "Snakefile"), "--directory", str(work)]
+        command = [sys.executable, "-m", "snakemake", *snakefile, "--cores", "2"]
+        command += ["--configfile", str(TINY_CONFIG)]
+        result = subprocess.run(
+            command, cwd=work, env=env, capture_output=True, text=True, timeout=_BUILD_TIMEOUT
+        )
+        assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+
+    return built_once("tiny", build) / "checkout"
 
 
 # ---- the library in a workflow run's own folder -----------------------------------------
