@@ -20,6 +20,7 @@ import os
 import shutil
 import subprocess
 import sys
+from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -193,33 +194,52 @@ def pytest_cmdline_main(config: pytest.Config) -> None:
         option.maxschedchunk = 1
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        "heavy(cpu_s): a workflow test that runs Snakemake jobs again on a copy of a run "
+        "built once, for about cpu_s seconds of CPU (measured): started as soon as that "
+        "run is built, the longest first (tests/conftest.py)",
+    )
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Order the tests for the workers; a serial run sees the same order.
 
     xdist gives each worker two tests to start with, then one more as each ends. So the
     first test of each shared workflow run (:func:`built_once`) goes at positions 0, 2,
     4, ..., each followed by a short test: every worker starts by building a different
-    run, rather than wait for another's. Then the other tests marked ``workflow``
-    (Snakemake runs, the longest), then the rest, which fill the end. Otherwise the
-    collection order.
+    run, rather than wait for another's, the run that most tests inspect first. Then
+    the other tests marked ``workflow``: those that need no shared run (a worker runs
+    them while the runs build), those marked ``heavy``, the longest first (the first of
+    them waits for its run, which then has both cores), the others; then the rest,
+    which fill the end. Otherwise the collection order.
     """
     runs = {item: _shared_run(item) for item in items}
+    users = Counter(run for run in runs.values() if run)
     builders = list({run: item for item in reversed(items) if (run := runs[item])}.values())
     builders.reverse()
+    builders.sort(key=lambda item: -users[runs[item]])
     short = [i for i in items if runs[i] is None and not i.get_closest_marker("workflow")]
     first = [item for pair in zip(builders, short) for item in pair]
     chosen = set(first)
     workflow = [i for i in items if i not in chosen and i.get_closest_marker("workflow")]
+    own = [i for i in workflow if runs[i] is None]
+    heavy = [i for i in workflow if runs[i] and i.get_closest_marker("heavy")]
+    heavy.sort(key=lambda item: -item.get_closest_marker("heavy").kwargs["cpu_s"])
+    workflow = own + heavy + [i for i in workflow if i not in set(own) | set(heavy)]
     chosen.update(workflow)
     items[:] = first + workflow + [i for i in items if i not in chosen]
 
 
 def _shared_run(item: pytest.Item) -> str | None:
-    """The fixture through which ``item`` uses a run built by :func:`built_once`."""
+    """The fixture through which ``item`` uses a run built by :func:`built_once`: the
+    last one that asks for it (a fixture that keeps something of another's run, as
+    test_reproducibility.py's reference copy of the tiny run, belongs to that run)."""
     definitions = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
     if "built_once" not in item.fixturenames:
         return None
-    for name in item.fixturenames:
+    for name in reversed(item.fixturenames):
         if any("built_once" in d.argnames for d in definitions.get(name, ())):
             return name
     return None

@@ -427,8 +427,12 @@ def resume(ws: Workspace, expected: dict, how: str) -> None:
 @pytest.mark.parametrize(
     ("first", "second"),
     [
-        ("SIGINT-group", "SIGKILL-group"),
-        pytest.param("SIGTERM-snakemake", "SIGTERM-group", marks=pytest.mark.slow),
+        pytest.param("SIGINT-group", "SIGKILL-group", marks=pytest.mark.heavy(cpu_s=55)),
+        pytest.param(
+            "SIGTERM-snakemake",
+            "SIGTERM-group",
+            marks=[pytest.mark.slow, pytest.mark.heavy(cpu_s=10)],
+        ),
     ],
     ids=["ctrl-c-then-crash", "sigterm-snakemake-then-group"],
 )

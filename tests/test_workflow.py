@@ -425,6 +425,7 @@ def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
     assert tally in result.stdout + result.stderr
 
 
+@pytest.mark.heavy(cpu_s=25)
 def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
     """A what-if changing only an analysis key reuses every simulation, the virtual
     experiment, the tracks and the studies' simulations (their jobs fit every
@@ -457,6 +458,7 @@ def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
     assert "tables/pulses.log" not in jobs  # every estimator's pulses are computed anyway
 
 
+@pytest.mark.heavy(cpu_s=85)
 def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     """``--forceall`` recomputes every job of the tiny run (Snakemake's convention)
     under another string-hash seed: every result has the bytes that were stored, so the
@@ -501,6 +503,7 @@ def test_a_run_folder_is_plain_files_with_their_checksums(tiny, tmp_path):
     assert check.returncode == 0
 
 
+@pytest.mark.heavy(cpu_s=20)
 def test_a_damaged_stored_result_is_named_and_computed_anew(tiny, tmp_path):
     """A stored simulation trace rewritten behind the store's back (another user of a
     world-writable store did so to Snakemake's cache): the next run names it on the
