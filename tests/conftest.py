@@ -18,6 +18,9 @@ import contextlib
 import math
 import os
 import shutil
+import subprocess
+import sys
+from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -232,24 +235,42 @@ def pytest_cmdline_main(config: pytest.Config) -> None:
         option.maxschedchunk = 1
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        "heavy(cpu_s): a workflow test that runs Snakemake jobs again on a copy of a run "
+        "built once, for about cpu_s seconds of CPU (measured): started as soon as that "
+        "run is built, the longest first (tests/conftest.py)",
+    )
+    config.pluginmanager.register(_CompilingFirst(), "hertzchain-compiling-first")
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Order the tests for the workers; a serial run sees the same order.
 
     xdist gives each worker two tests to start with, then one more as each ends. So the
     first test of each shared workflow run (:func:`built_once`) goes at positions 0, 2,
     4, ..., each followed by a short test: every worker starts by building a different
-    run, rather than wait for another's. Then the other tests marked ``workflow``
-    (Snakemake runs, the longest), then the rest, which fill the end (those that
-    compile numba's kernels first, once the tests not selected are left out:
-    :class:`_CompilingFirst`). Otherwise the collection order.
+    run, rather than wait for another's, the run that most tests inspect first. Then
+    the other tests marked ``workflow``: those that need no shared run (a worker runs
+    them while the runs build), those marked ``heavy``, the longest first (the first of
+    them waits for its run, which then has both cores), the others; then the rest,
+    which fill the end (those that compile numba's kernels first, once the tests not
+    selected are left out: :class:`_CompilingFirst`). Otherwise the collection order.
     """
     runs = {item: _shared_run(item) for item in items}
+    users = Counter(run for run in runs.values() if run)
     builders = list({run: item for item in reversed(items) if (run := runs[item])}.values())
     builders.reverse()
+    builders.sort(key=lambda item: -users[runs[item]])
     short = [i for i in items if runs[i] is None and not i.get_closest_marker("workflow")]
     first = [item for pair in zip(builders, short) for item in pair]
     chosen = set(first)
     workflow = [i for i in items if i not in chosen and i.get_closest_marker("workflow")]
+    own = [i for i in workflow if runs[i] is None]
+    heavy = [i for i in workflow if runs[i] and i.get_closest_marker("heavy")]
+    heavy.sort(key=lambda item: -item.get_closest_marker("heavy").kwargs["cpu_s"])
+    workflow = own + heavy + [i for i in workflow if i not in set(own) | set(heavy)]
     chosen.update(workflow)
     items[:] = first + workflow + [i for i in items if i not in chosen]
 
@@ -266,10 +287,6 @@ class _CompilingFirst:
         marked = [n for n, item in enumerate(items) if item.get_closest_marker("workflow")]
         start = marked[-1] + 1 if marked else 0
         items[start:] = _compiling_first(items[start:])
-
-
-def pytest_configure(config: pytest.Config) -> None:
-    config.pluginmanager.register(_CompilingFirst(), "hertzchain-compiling-first")
 
 
 def _compiling_first(items: list[pytest.Item]) -> list[pytest.Item]:
@@ -292,11 +309,13 @@ def _compiling_first(items: list[pytest.Item]) -> list[pytest.Item]:
 
 
 def _shared_run(item: pytest.Item) -> str | None:
-    """The fixture through which ``item`` uses a run built by :func:`built_once`."""
+    """The fixture through which ``item`` uses a run built by :func:`built_once`: the
+    last one that asks for it (a fixture that keeps something of another's run, as
+    test_reproducibility.py's reference copy of the tiny run, belongs to that run)."""
     definitions = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
     if "built_once" not in item.fixturenames:
         return None
-    for name in item.fixturenames:
+    for name in reversed(item.fixturenames):
         if any("built_once" in d.argnames for d in definitions.get(name, ())):
             return name
     return None
@@ -428,6 +447,48 @@ def cold_step_loop_jobs(request) -> tuple[list[dict], Path]:
 
     folder = request.getfixturevalue("built_once")(COLD_STEP_LOOP, build)
     return json.loads((folder / "reports.json").read_text()), folder / "numba"
+
+
+# ---- the tiny run: the workflow tests' one build --------------------------------------
+
+#: The workflow tests' config, overlaid on config.yaml: every rule on short chains.
+TINY_CONFIG = ROOT / "tests" / "configs" / "tiny.yaml"
+
+#: Not copied into the tiny run's checkout: caches and earlier results.
+_NOT_COPIED = shutil.ignore_patterns("__pycache__", "*.pyc", "results", ".snakemake")
+
+#: Longest the tiny run's build may take, s: a guard against a hang, far above its
+#: minutes on a machine shared with the other worker (pytest-xdist) or other work.
+_BUILD_TIMEOUT = 1800
+
+
+@pytest.fixture(scope="session")
+def tiny_run(built_once, copy_library) -> Path:
+    """The tiny run (:data:`TINY_CONFIG`), built from nothing with ``--cores 2`` once per
+    test session (:func:`built_once`) in a copy of the checkout: Snakefile, workflow/,
+    profiles/, config.yaml and the library in src/ (:func:`copy_library`), started
+    there as a user would: the copy's folder, its results in ``results/tiny/``.
+
+    test_workflow.py and test_reproducibility.py both inspect it; a test that changes
+    it (a rebuild, an edit, another run) works on a copy."""
+
+    def build(base: Path) -> None:
+        work = base / "checkout"
+        work.mkdir()
+        for name in ("config.yaml", "Snakefile"):
+            shutil.copy(ROOT / name, work / name)
+        for name in ("workflow", "profiles"):
+            shutil.copytree(ROOT / name, work / name, ignore=_NOT_COPIED)
+        env = copy_library(work / "src")
+        snakefile = ["--snakefile", str(work / "Snakefile"), "--directory", str(work)]
+        command = [sys.executable, "-m", "snakemake", *snakefile, "--cores", "2"]
+        command += ["--configfile", str(TINY_CONFIG)]
+        result = subprocess.run(
+            command, cwd=work, env=env, capture_output=True, text=True, timeout=_BUILD_TIMEOUT
+        )
+        assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
+
+    return built_once("tiny", build) / "checkout"
 
 
 # ---- the library in a workflow run's own folder -----------------------------------------

@@ -1,22 +1,24 @@
 """Reproducibility (issue 6): the same bytes from every rebuild, outputs that survive an
 interruption, and numerical guard rails.
 
-Workflow tests (marked ``workflow``) build tests/configs/repro.yaml once per test session
-in a temporary copy of the workflow (Snakefile, workflow/, config.yaml; the library
-copied and put on ``PYTHONPATH``, as in test_workflow.py), then, each in its own copy of
-that first build (so that they may run at the same time, in pytest-xdist's workers),
+Workflow tests (marked ``workflow``) take the tiny run (tests/configs/tiny.yaml, every
+rule), which conftest.py's ``tiny_run`` builds once per test session with 2 cores in a
+temporary copy of the checkout (Snakefile, workflow/, config.yaml; the library copied
+and put on ``PYTHONPATH``) for test_workflow.py too, then, each in its own copy of that
+first build (so that they may run at the same time, in pytest-xdist's workers),
 
-* (the first build runs on 1 core and the interrupted rebuilds below on 2, which
-  require the same bytes in every file of ``results/repro/`` but ``logs/`` and
-  ``benchmarks/``, summary.md and the article included; a second build of every rule
-  under another ``PYTHONHASHSEED``, and a reused result against a recomputed one, is
-  test_workflow.py's test_a_recomputed_run_gives_the_stored_bytes, on the tiny run);
+* (a second build of every rule on 1 core under another ``PYTHONHASHSEED``, which
+  requires the same bytes in every file of ``results/tiny/`` but ``logs/`` and
+  ``benchmarks/``, summary.md and the article included, and a reused result against a
+  recomputed one, is test_workflow.py's test_a_recomputed_run_gives_the_stored_bytes;
+  the interrupted rebuilds below run on 2 cores and require those bytes again);
 * look for the temporary directory, the checkout's path and today's date in the files;
 * interrupt a ``--forceall`` rebuild as soon as a simulation output is being written
-  (Ctrl-C), then the user's next command as soon as a table is being written (a
-  crash: SIGKILL), check after each that every file under its final name is still a
-  complete one, run what the user must type, and require the same bytes again; the
-  same with SIGTERM to Snakemake, then to the process group (marked ``slow``).
+  (Ctrl-C), then a forced rebuild of the tables (and all after them) as soon as a
+  table is being written (a crash: SIGKILL), check after each that every file under
+  its final name is still a complete one, run what the user must type, and require
+  the same bytes again; the same with SIGTERM to Snakemake, then to the process group
+  (marked ``slow``).
 
 What Snakemake 9 (measured with 9.27) does when interrupted, and what to type next:
 
@@ -89,9 +91,9 @@ from chain.traces import (
 )
 
 ROOT = Path(__file__).resolve().parents[1]
-CONFIG = ROOT / "tests" / "configs" / "repro.yaml"
-RUN = "repro"
-SNAKEMAKE = [sys.executable, "-m", "snakemake", "--configfile", "repro.yaml"]
+CONFIG = ROOT / "tests" / "configs" / "tiny.yaml"
+RUN = "tiny"
+SNAKEMAKE = [sys.executable, "-m", "snakemake", "--configfile", str(CONFIG)]
 #: Top-level entries of results/<run>/ that legitimately hold times: not compared
 #: (SHA256SUMS lists the logs' digests; it must check, test_interrupted_rebuild...).
 TIMED = ("logs", "benchmarks", "report.html", "SHA256SUMS")
@@ -105,8 +107,8 @@ TIMEOUT = 1800
 
 @dataclass(frozen=True)
 class Workspace:
-    base: Path  # temporary directory: work/, lib/
-    work: Path  # Snakemake's working directory (a copy of the workflow)
+    base: Path  # temporary directory: work/
+    work: Path  # Snakemake's working directory (a copy of the checkout, the library in src/)
     env: dict
     reference: Path  # the first build's results, for the failure messages
 
@@ -115,30 +117,12 @@ class Workspace:
         return self.work / "results" / RUN
 
 
-def make_workspace(base: Path, copy_library) -> None:
-    """The workflow and the repro config in ``base``/work, the library in ``base``/lib."""
-    work = base / "work"
-    work.mkdir()
-    for name in ("Snakefile", "config.yaml"):
-        shutil.copy2(ROOT / name, work / name)
-    shutil.copytree(
-        ROOT / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__")
-    )
-    shutil.copy2(CONFIG, work / "repro.yaml")
-    copy_library(base / "lib")  # with numba's compiled kernels (conftest.py)
-
-
-def workspace(base: Path, env_of_library) -> Workspace:
-    """The workspace :func:`make_workspace` made in ``base``."""
-    return Workspace(base, base / "work", env_of_library(base / "lib"), base / "reference")
-
-
 def copy_workspace(ws: Workspace, base: Path, env_of_library) -> Workspace:
-    """A copy of ``ws`` in ``base``: the workflow with its results and Snakemake's
-    records, and the library with its compiled kernels; copy2 keeps the files' times."""
-    for part in ("work", "lib"):
-        shutil.copytree(ws.base / part, base / part, symlinks=True, copy_function=shutil.copy2)
-    return Workspace(base, base / "work", env_of_library(base / "lib"), ws.reference)
+    """A copy of ``ws`` in ``base``: the checkout with its results, Snakemake's records
+    and the library with its compiled kernels; copy2 keeps the files' times."""
+    work = base / "work"
+    shutil.copytree(ws.work, work, symlinks=True, copy_function=shutil.copy2)
+    return Workspace(base, work, env_of_library(work / "src"), ws.reference)
 
 
 def snakemake(ws: Workspace, *args, env: dict | None = None) -> subprocess.CompletedProcess:
@@ -219,22 +203,22 @@ def assert_same_bytes(
 
 
 @pytest.fixture(scope="session")
-def built(built_once, copy_library, env_of_library):
-    """Run 1: the repro config built from nothing with --cores 1, once per test session
-    (the interrupted rebuilds run with 2 cores: the same bytes, summary.md and the
-    article included, show that 1 core gives those of 2);
-    (workspace, digest). A copy of its results is kept in <base>/reference, the digest's
-    source and the failure messages' reference. Tests that build again do so in a copy
-    (:func:`rebuilt`)."""
+def built(tiny_run, built_once, env_of_library):
+    """Run 1: the tiny run (conftest.py's ``tiny_run``, test_workflow.py's too), built
+    from nothing with --cores 2 once per test session (a second build of every rule on
+    1 core must give the same bytes, summary.md and the article included:
+    test_workflow.py's test_a_recomputed_run_gives_the_stored_bytes);
+    (workspace, digest). A copy of its results is kept in <tiny-reference>/tiny, the
+    digest's source and the failure messages' reference. Tests that build again do so in
+    a copy (:func:`rebuilt`)."""
 
-    def build(base: Path) -> None:
-        make_workspace(base, copy_library)
-        ws = workspace(base, env_of_library)
-        result = snakemake(ws, "--cores", "1")
-        assert result.returncode == 0, tail(result)
-        shutil.copytree(ws.out, ws.reference, ignore=shutil.ignore_patterns(*TIMED))
+    def keep(base: Path) -> None:
+        shutil.copytree(
+            tiny_run / "results" / RUN, base / RUN, ignore=shutil.ignore_patterns(*TIMED)
+        )
 
-    ws = workspace(built_once("repro", build), env_of_library)
+    reference = built_once("tiny-reference", keep) / RUN
+    ws = Workspace(tiny_run.parent, tiny_run, env_of_library(tiny_run / "src"), reference)
     expected = digest(ws.reference)
     assert expected == digest(ws.out)
     assert any(f.startswith("figures/") and f.endswith(".pdf") for f in expected), expected
@@ -323,6 +307,14 @@ INTERRUPTIONS = {
     "SIGTERM-group": (signal.SIGTERM, True),
     "SIGKILL-group": (signal.SIGKILL, True),
 }
+
+#: The rules that write results/<run>/tables/ in the tiny run, with or without LAMMPS:
+#: the second interruption's forced rebuild (``--forcerun``: them and every job after
+#: them).
+TABLE_RULES = (
+    "pulses", "delays", "delay_fits", "ssw", "ssw_fits", "ssw_speed", "c_sensitivity_table",
+    "ablation_table", "ssw_mechanisms",
+)  # fmt: skip
 
 #: What the user types after each interruption (the module docstring says why).
 AFTERWARDS = {
@@ -435,8 +427,12 @@ def resume(ws: Workspace, expected: dict, how: str) -> None:
 @pytest.mark.parametrize(
     ("first", "second"),
     [
-        ("SIGINT-group", "SIGKILL-group"),
-        pytest.param("SIGTERM-snakemake", "SIGTERM-group", marks=pytest.mark.slow),
+        pytest.param("SIGINT-group", "SIGKILL-group", marks=pytest.mark.heavy(cpu_s=55)),
+        pytest.param(
+            "SIGTERM-snakemake",
+            "SIGTERM-group",
+            marks=[pytest.mark.slow, pytest.mark.heavy(cpu_s=10)],
+        ),
     ],
     ids=["ctrl-c-then-crash", "sigterm-snakemake-then-group"],
 )
@@ -445,8 +441,12 @@ def test_interrupted_rebuild_resumes_to_the_same_bytes(rebuilt, first, second):
     then the user's command; a forced rebuild interrupted (``second``) while the tables
     are being written, then the user's command: the same bytes as an uninterrupted
     build, and after each interruption every file under its final name is a complete
-    one. (Each interruption hits a full forced rebuild, so that the run cannot end
-    before the watched files are written, whatever the machine's speed.)"""
+    one. (Each interruption hits a forced rebuild of the jobs that write the watched
+    folder, so that the run cannot end before the watched files are written, whatever
+    the machine's speed: the first a full one, the second one of the tables and
+    everything after them, :data:`TABLE_RULES`; a full one would compute every
+    simulation again before the first table, and the user's command then every table
+    and figure after them, which the first interruption already covers.)"""
     ws, expected = rebuilt
     interrupted_run(ws, expected, ["--forceall", "--cores", "2"], "simulation", first)
     resume(ws, expected, first)
@@ -461,7 +461,8 @@ def test_interrupted_rebuild_resumes_to_the_same_bytes(rebuilt, first, second):
         may_be_missing=INTERMEDIATES,
     )
     assert_checksums_hold(ws.out)
-    interrupted_run(ws, expected, ["--forceall", "--cores", "2"], "tables", second)
+    forced_tables = ["--forcerun", *TABLE_RULES, "--cores", "2"]
+    interrupted_run(ws, expected, forced_tables, "tables", second)
     resume(ws, expected, second)
     assert_same_bytes(
         ws, expected, f"interrupted ({second}) and resumed", may_be_missing=INTERMEDIATES

@@ -34,9 +34,6 @@ SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 pytestmark = pytest.mark.workflow
 
-#: Not copied into a work tree: caches and earlier results.
-IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", "results", ".snakemake")
-
 #: Columns each contract table must have (results contract + docs/interfaces.md).
 TABLE_COLUMNS = {
     "pulses": [
@@ -120,23 +117,13 @@ def planned_jobs(work: Path, env: dict) -> dict[str, int]:
 
 
 @pytest.fixture(scope="session")
-def tiny(built_once, copy_library):
-    """The tiny run, done once per test session in a copy of the checkout (Snakefile,
-    workflow, config, library): (work directory, results directory, env, library folder).
-    Shared by every test that asks for it: a test that edits the copy edits a copy of
-    it (:func:`checkout_copy`)."""
-
-    def build(folder: Path) -> None:
-        work = folder / "checkout"
-        work.mkdir()
-        for name in ("config.yaml", "Snakefile"):
-            shutil.copy(ROOT / name, work / name)
-        for folder in ("workflow", "profiles"):
-            shutil.copytree(ROOT / folder, work / folder, ignore=IGNORED)
-        result = run(["--cores", "2", "--configfile", str(TINY)], work, copy_library(work / "src"))
-        assert result.returncode == 0, (result.stdout + result.stderr)[-5000:]
-
-    return checkout(built_once("tiny", build) / "checkout")
+def tiny(tiny_run):
+    """The tiny run (conftest.py's ``tiny_run``: built once per test session with 2 cores
+    in a copy of the checkout: Snakefile, workflow, config, library): (work directory,
+    results directory, env, library folder). Shared by every test that asks for it, and
+    by test_reproducibility.py: a test that edits the copy edits a copy of it
+    (:func:`checkout_copy`)."""
+    return checkout(tiny_run)
 
 
 def checkout(work: Path) -> tuple[Path, Path, dict, Path]:
@@ -388,14 +375,17 @@ def started(output: str) -> set[str]:
     return set(re.findall(r"^(?:local)?rule (\w+):$", output, re.M)) - {"all"}
 
 
-def differing_results(a: Path, b: Path) -> list[str]:
-    """Result files of run folder ``a`` missing from ``b`` or with other bytes there."""
+def differing_results(a: Path, b: Path, *, per_run: bool = False) -> list[str]:
+    """Result files of run folder ``a`` missing from ``b`` or with other bytes there; with
+    ``per_run``, the files a run writes about itself too (summary, article), all but
+    SHA256SUMS (it lists the logs)."""
+    skipped = {"SHA256SUMS"} if per_run else set(PER_RUN_FILES)
     names = [
         p.relative_to(a)
         for p in sorted(a.rglob("*"))
         if p.is_file()
         and not {"logs", "benchmarks"} & set(p.relative_to(a).parts)
-        and p.name not in PER_RUN_FILES
+        and p.name not in skipped
     ]
     assert len(names) > 50, names  # tables, figures, traces, the virtual datasets
     return [
@@ -435,6 +425,7 @@ def test_a_renamed_run_reuses_every_result(tiny, tmp_path):
     assert tally in result.stdout + result.stderr
 
 
+@pytest.mark.heavy(cpu_s=25)
 def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
     """A what-if changing only an analysis key reuses every simulation, the virtual
     experiment, the tracks and the studies' simulations (their jobs fit every
@@ -467,15 +458,20 @@ def test_an_analysis_what_if_runs_no_simulation(tiny, tmp_path):
     assert "tables/pulses.log" not in jobs  # every estimator's pulses are computed anyway
 
 
+@pytest.mark.heavy(cpu_s=85)
 def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     """``--forceall`` recomputes every job of the tiny run (Snakemake's convention)
     under another string-hash seed: every result has the bytes that were stored, so the
     store keeps its entries and names no difference. One run shows that a reused result
-    is the recomputed one and that a second build gives the same bytes."""
+    is the recomputed one and that a second build gives the same bytes.
+
+    It runs on 1 core (the tiny run on 2): the same bytes in every file of
+    ``results/tiny/`` but ``logs/``, ``benchmarks/`` and SHA256SUMS, summary.md and the
+    article included, show that 1 core gives those of 2 (test_reproducibility.py)."""
     work, out, env, _ = checkout_copy(tiny[0], tmp_path)
     store = work / "results" / ".store"
     stored = sorted(p.name for p in store.glob("??/*"))
-    args = ["--forceall", "--cores", "2", "--configfile", str(TINY)]
+    args = ["--forceall", "--cores", "1", "--configfile", str(TINY)]
     result = run(args, work, {**env, "PYTHONHASHSEED": "2"})
     output = result.stdout + result.stderr
     assert result.returncode == 0, output[-5000:]
@@ -484,6 +480,7 @@ def test_a_recomputed_run_gives_the_stored_bytes(tiny, tmp_path):
     assert ran(out) == {str(p.relative_to(out / "logs")) for p in (out / "logs").rglob("*.log")}
     assert sorted(p.name for p in store.glob("??/*")) == stored
     assert differing_results(tiny[1], out) == [] and same_summary(tiny[1], out)
+    assert differing_results(tiny[1], out, per_run=True) == []
 
 
 def test_a_run_folder_is_plain_files_with_their_checksums(tiny, tmp_path):
@@ -506,6 +503,7 @@ def test_a_run_folder_is_plain_files_with_their_checksums(tiny, tmp_path):
     assert check.returncode == 0
 
 
+@pytest.mark.heavy(cpu_s=20)
 def test_a_damaged_stored_result_is_named_and_computed_anew(tiny, tmp_path):
     """A stored simulation trace rewritten behind the store's back (another user of a
     world-writable store did so to Snakemake's cache): the next run names it on the
