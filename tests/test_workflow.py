@@ -24,6 +24,7 @@ import pytest
 
 from chain.analysis.ssw_speed import SPEED_COLUMNS
 from chain.analysis.ssw_track import TRACK_COLUMNS
+from chain.pipeline.plan import figures
 from chain.report.printed import plus_minus
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -284,6 +285,19 @@ def test_article_embeds_every_figure_and_prints_the_fits(tiny):
         assert re.sub(r"\s+", "", printed).replace("10^", "10") in text, row
     # Not a git checkout (a copy): the article says so rather than failing.
     assert "notagitcheckout" in text
+
+
+def test_every_registered_figure_is_in_the_html_report(tiny, tmp_path):
+    """Each figure of the registry the tiny run made is in Snakemake's HTML report
+    (``--report``), under its own name, and the run made no figure the registry lacks."""
+    work, out, env, _ = tiny
+    made = {path.stem for path in (out / "figures").glob("*.png")}
+    assert made <= {figure.name for figure in figures.FIGURES} and made >= set(FIGURES)
+    report = tmp_path / "report.html"
+    result = run(["--report", str(report), "--configfile", str(TINY)], work, env)
+    assert result.returncode == 0, result.stderr[-3000:]
+    html = report.read_text()
+    assert not [name for name in sorted(made) if f"{name}.png" not in html]
 
 
 def test_article_layout_is_clean(tiny):
