@@ -1,5 +1,5 @@
 """Cold compile of the kernels: the first chain.simulate of each kind of model in a fresh
-interpreter whose numba cache is empty (issue 54), and what the compile spends its time on.
+interpreter whose numba cache is empty, and what the compile spends its time on.
 
 Run from the repository root::
 
@@ -147,7 +147,7 @@ def report(args, best: dict, conditions: Conditions, others: float) -> None:
             print(f"    {key:8s} {wall:6.2f} s wall  {cpu:6.2f} s CPU")
     if conditions.under_load:
         print("UNDER LOAD: the figures above are upper bounds")
-    targets = {"elastic": 3.0, "damped": 3.0, "both": 5.0}  # s, issue 54, on its Xeon
+    targets = {"elastic": 3.0, "damped": 3.0, "both": 5.0}  # s, on a 2-core Xeon
     figures = [
         Figure(f"cold compile, {key} ({name})", wall, "s",
                "numba's type inference and lowering of the step loop, then LLVM", None,

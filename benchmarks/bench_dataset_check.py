@@ -1,4 +1,4 @@
-"""Benchmark of the dataset check the pipeline runs before every run (issue 15).
+"""Benchmark of the dataset check the pipeline runs before every run.
 
 Run from the repository root::
 

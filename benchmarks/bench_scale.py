@@ -4,12 +4,12 @@ Run from the repository root::
 
     python benchmarks/bench_scale.py                  # N = 1,000, 10,000, 100,000 x 1 ms
     python benchmarks/bench_scale.py --sizes 1000 10000 --duration 5e-3
-    python benchmarks/bench_scale.py --sensors        # issue 14's record: 2 sensor beads
+    python benchmarks/bench_scale.py --sensors        # record 2 sensor beads only
 
 Each N runs in its own Python process on one thread (so that its peak memory,
 ``VmHWM`` through ``measure.peak_memory_mb``, is its own): one collision (+V0 / -V0,
 V0 = 0.3 m/s) of N elastic beads for ``--duration`` at the default step, through
-``chain.simulate`` with its defaults (issue 25: an overview of a long chain, every
+``chain.simulate`` with its defaults (an overview of a long chain, every
 stride-th contact and bead), or with ``--sensors`` recording only the force felt by two
 sensor beads (at N/3 and 2N/3) and the energies. It prints the best CPU and wall time
 of ``--repeat`` (>= 7) runs of ``simulate`` (after compilation), ``default_time_step``
@@ -17,8 +17,8 @@ alone, the process's peak resident memory, and the growth of the time from one N
 the next (10x more beads: linear growth is a ratio of 10), with the load average
 before and after, and writes them to benchmarks/results/ (``measure.write_result``).
 
-Targets: issue 25, 100,000 beads x 1 ms at most linear in N (growth <= ~10); issue 14,
-N = 10,000 x 5 ms in < 10 s and < 1 GB (issue 25's < 4 s and < 300 MB:
+Targets: 100,000 beads x 1 ms at most linear in N (growth <= ~10); with sensors,
+N = 10,000 x 5 ms in < 10 s and < 1 GB (the integrator's own < 4 s and < 300 MB:
 bench_integrator.py).
 Not a test: it reports.
 """

@@ -1,4 +1,4 @@
-"""Measurement discipline shared by the benchmarks (issue 25, item 4).
+"""Measurement discipline shared by the benchmarks.
 
 The machines the benchmarks run on are shared and noisy, so every speed figure is:
 

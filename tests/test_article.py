@@ -438,7 +438,7 @@ SMALL_NUMBERS = {
 
 
 def test_no_raw_e_notation_in_the_article(tmp_path, figures):
-    """Issue 32 item 5: the article writes 5.5 × 10⁻¹⁰, never 5.5e-10: not in its typst
+    """The article writes 5.5 × 10⁻¹⁰, never 5.5e-10: not in its typst
     source, not in the strings it is given, not in the text of the PDF."""
     assert not E_NOTATION.findall(SOURCE.read_text())
     summary = {**copy.deepcopy(SUMMARY), **FINDINGS, **SMALL_NUMBERS}
@@ -452,7 +452,7 @@ def test_no_raw_e_notation_in_the_article(tmp_path, figures):
 
 def test_the_why_not_of_the_simulated_c_quotes_the_mechanism_study():
     """With the mechanism study, the claim that Eq. 1 misses the measured Δ says what
-    friction does to C (issue 31 item 4); without it, the paper's explanation."""
+    friction does to C; without it, the paper's explanation."""
     name = "Simulations of Eq. 1 close to the measured Δ (simulation, viscoelastic)"
     study = {
         "verdict": "",

@@ -1,4 +1,4 @@
-"""Bad configs (issue 15): every one stopped by the checks the Snakefile runs before any
+"""Bad configs: every one stopped by the checks the Snakefile runs before any
 job, with a message naming the key, and nothing written under results/.
 
 The checks are run as the Snakefile runs them (config files as text, the JSON schema,

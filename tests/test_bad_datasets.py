@@ -1,4 +1,4 @@
-"""Bad measured datasets (issue 15): stopped when the DAG is built, every problem of a
+"""Bad measured datasets: stopped when the DAG is built, every problem of a
 dataset listed at once, one line each naming the file (and line and column where one
 applies), nothing written under results/; dead or saturated channels named by file and
 channel, stopping the run or skipped (experiment.bad_channels); and a property test

@@ -1,4 +1,4 @@
-"""Bad input through Snakemake itself (issue 15): a few representative cases, the rest
+"""Bad input through Snakemake itself: a few representative cases, the rest
 are in test_bad_configs.py and test_bad_datasets.py through the same library checks.
 
 Each run uses an overlay in a temporary folder with its own run_name, in this checkout

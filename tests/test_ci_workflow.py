@@ -76,7 +76,7 @@ def _python(job: dict) -> str:
 
 
 def test_runs_install_their_pythons_lock_and_a_weekly_job_the_newest():
-    """Issue 32: the runs install the lock of their Python with hashes, then the project
+    """The runs install the lock of their Python with hashes, then the project
     without dependencies; one scheduled job installs the ranges' newest versions (no lock)
     and runs the paper run, the number check and the tests."""
     workflow = yaml.safe_load(WORKFLOWS[0].read_text(encoding="utf-8"))

@@ -117,7 +117,7 @@ def _with(*changes: str) -> list[str]:
 @pytest.mark.parametrize(
     ("arguments", "option", "library_name"),
     [
-        # issue 32: the library's check speaks of its parameter, the message of the option
+        # the library's check speaks of its parameter, the message of the option
         (_with("-N", "1"), "-N must be an integer >= 2, got 1", "n_beads"),
         (_with("--speed", "-0.3"), "--speed must be finite and >= 0 m/s, got -0.3", "v_left"),
         (_with("--speed", "nan"), "--speed must be finite", "v_left"),

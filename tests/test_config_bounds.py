@@ -1,4 +1,4 @@
-"""Config bounds (issue 32, item 3): every value outside a key's range stops the run
+"""Config bounds: every value outside a key's range stops the run
 before any job, naming the key; the values at the bounds pass; docs/config_bounds.md is
 the table the schema and chain.pipeline.config.bounds_table.RULES give.
 
@@ -254,7 +254,7 @@ def test_table_is_generated_from_schema_and_rules():
 
 
 def test_every_key_has_a_largest_value_or_a_reason():
-    """Issue 32 item 3: a smallest and a largest usable value per key; where the schema
+    """A smallest and a largest usable value per key; where the schema
     has no largest, RULES says what bounds it or why nothing does."""
     rows = table_rows(yaml.safe_load(SCHEMA.read_text()))
     blank = [key for key, _, kind, _, upper, rule in rows if not upper and not rule]

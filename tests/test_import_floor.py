@@ -1,7 +1,7 @@
 """What a job pays at start-up: the heavy packages each part of the library imports.
 
 Each job is a fresh interpreter, and numba, scipy, pandas and matplotlib each take most
-of a second to import (issue 33). The rules: ``import chain`` and its subpackages cost
+of a second to import. The rules: ``import chain`` and its subpackages cost
 nothing; the analysis imports neither numba, matplotlib nor scipy until it fits (scipy
 where a function uses it); the report never imports numba or scipy; the Snakefile's
 config checks import neither numba nor scipy nor pandas, and its whole parse (run plan,

@@ -22,7 +22,7 @@ from chain.physics.simulation import simulate
 RADIUS = 13e-3
 ETA = 0.58e-6
 
-#: The cross-check's target (issue 24): sensor traces within 1e-4 F_m. Velocity Verlet
+#: The cross-check's target: sensor traces within 1e-4 F_m. Velocity Verlet
 #: at 2.5e-8 s against RK4 measures ~3e-7 F_m elastic and ~3e-5 F_m with Kuwabara-Kono
 #: (LAMMPS evaluates the damping with the half-step velocity: first order in dt).
 TRACE_TOLERANCE = 1e-4

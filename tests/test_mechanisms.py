@@ -1,4 +1,4 @@
-"""The mechanism study (issue 24): the virtual experiment's candidate ingredients (bead
+"""The mechanism study: the virtual experiment's candidate ingredients (bead
 radius dispersion, gaps at rest, an off-centre collision), and the table and verdict
 that compare each with its reference."""
 

@@ -1,5 +1,5 @@
 """The run plan (chain.pipeline.plan.run_plan.RunPlan): each fact of a run derived once from the
-checked config, and a simulate job's inputs as a cache key (issue 31, issue 33)."""
+checked config, and a simulate job's inputs as a cache key."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Reproducibility (issue 6): the same bytes from every rebuild, outputs that survive an
+"""Reproducibility: the same bytes from every rebuild, outputs that survive an
 interruption, and numerical guard rails.
 
 Workflow tests (marked ``workflow``) take the tiny run (tests/configs/tiny.yaml, every

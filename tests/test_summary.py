@@ -413,7 +413,7 @@ def test_ssw_keys_and_rows():
 
 
 def test_markdown_has_no_raw_e_notation(summary):
-    """Issue 32 item 5: very small or large numbers are written with a power of ten,
+    """Very small or large numbers are written with a power of ten,
     in the rendered summary.md as in the article (chain.report.printed.power_of_ten)."""
     data = copy.deepcopy(summary)
     data["max_energy_drift"] = 5.48e-10
