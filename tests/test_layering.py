@@ -15,6 +15,7 @@ figures, and the report without an integrator.
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -264,3 +265,39 @@ def test_report_package_inits_import_nothing():
         *(f"chain.report.{part}" for part in ("figures", "numbers", "text")),
     ):
         assert not {n for n in imports(MODULES[name]) if n.startswith("chain")}, name
+
+
+def test_the_plan_is_in_parts_none_too_big():
+    """Each study and concern of the run plan is a module of its own: none over 300 lines,
+    no class over 20 methods (RunPlan composes the parts)."""
+    for path in sorted((PACKAGE / "pipeline" / "plan").glob("*.py")):
+        text = path.read_text()
+        assert len(text.splitlines()) <= 300, path.name
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ClassDef):
+                methods = [b for b in node.body if isinstance(b, ast.FunctionDef)]
+                assert len(methods) <= 20, f"{path.name}: {node.name}"
+
+
+WORKFLOW = PACKAGE.parents[1] / "workflow"
+
+
+def test_rule_files_share_names_through_common_only():
+    """A name defined at the top of a rule file other than common.smk is used in that
+    file only: the includes' order makes nothing work by accident."""
+    files = {path: path.read_text() for path in (WORKFLOW / "rules").glob("*.smk")}
+    files[PACKAGE.parents[1] / "Snakefile"] = (PACKAGE.parents[1] / "Snakefile").read_text()
+    for path, text in files.items():
+        if path.name == "common.smk":
+            continue
+        defined = re.findall(r"^(?:def\s+(\w+)|(\w+)\s*=)", text, re.M)
+        for name in {a or b for a, b in defined}:
+            users = [p.name for p, t in files.items() if p != path and re.search(rf"\b{name}\b", t)]
+            assert not users, f"{name} of {path.name} used in {users}"
+
+
+def test_no_private_name_of_snakemake_is_read():
+    """Scripts are plain Snakemake scripts: nothing reads how Snakemake runs them."""
+    for root in (PACKAGE, WORKFLOW):
+        for path in root.rglob("*.py"):
+            assert "__real_file__" not in path.read_text(), path
