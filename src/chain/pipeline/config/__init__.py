@@ -37,6 +37,24 @@ def slowest_passing(config: Mapping, v0: float) -> dict:
     return max(map(passing, config["chains"]), key=lambda found: found["time_s"])
 
 
+def check_passing(config: Mapping, path, duration: float, v0: float, what: str, margin: float):
+    """``duration`` (s) >= ``margin`` x the time the wave of bead 1 launched at ``v0``
+    (m/s) takes to pass the far sensor of the chain it passes last
+    (:func:`slowest_passing`); ``what`` names the launch, ``path`` the key."""
+    worst = slowest_passing(config, v0)
+    needed = margin * worst["time_s"]
+    if duration < needed:
+        fail(
+            path,
+            f"{duration:g} s is too short: the slowest wave ({what} at V0 = {v0:g} m/s: "
+            f"F_m ~ {worst['force_N']:.3g} N, Eq. 5 speed {worst['speed_m_s']:.0f} m/s) has "
+            f"passed bead {worst['bead']} of the N = {worst['N']} chain, "
+            f"{worst['distance_m']:.3g} m from its launching end, at "
+            f"~{worst['time_s'] * 1e3:.3g} ms; allowed: >= {margin:g} x that = {needed:.3g} s "
+            "(or faster launches)",
+        )
+
+
 def launch_ratios(config: Mapping, virtual: Mapping) -> tuple[float, float]:
     """(least, most) V_m / V0 of the launch of ``virtual`` (``experiment.virtual`` of the
     schema-valid ``config``): a striker of mass m_s stops or bounces back elastically,

@@ -18,10 +18,10 @@ from chain.analysis.pulses import DEFAULT_MIN_SNR
 from chain.physics.materials import get_material, sphere_mass
 from chain.physics.theory import LAUNCH_VELOCITY_RATIO
 from chain.physics.time_step import STEPS_PER_SPRING_PERIOD
-from chain.pipeline.config import fail, launch_ratios, slowest_passing
+from chain.pipeline.config import check_passing, fail, launch_ratios, slowest_passing
 from chain.pipeline.config.bounds_run import (
+    DURATION_MARGIN,
     MIN_SENSOR_DISTANCE,
-    check_passing,
     check_resolution,
     pulse_force,
     pulse_speed,
@@ -177,7 +177,7 @@ def check_experiment_bounds(config: Mapping) -> None:
     # Duration: the slowest launch's wave at the most it can be passes the far sensors.
     v0 = ratios[1] * slowest / LAUNCH_VELOCITY_RATIO
     what = f"{virtual['launch']} at {slowest:g} m/s, as bead 1 launched"
-    check_passing(config, [*base, "duration_s"], duration, v0, what)
+    check_passing(config, [*base, "duration_s"], duration, v0, what, DURATION_MARGIN)
     _check_detection(config, virtual, speeds, ratios)
     _check_sensor_spring(config, virtual)
     _check_delay(config, virtual, speeds, ratios)

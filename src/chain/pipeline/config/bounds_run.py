@@ -19,7 +19,7 @@ from chain.physics.theory import (
     nesterenko_speed_from_force,
     pulse_half_width,
 )
-from chain.pipeline.config import check_samples, fail, slowest_passing
+from chain.pipeline.config import check_passing, check_samples, fail
 from chain.studies.mechanism_settings import setting_name, sweep_settings, viscous_name
 
 #: A duration of LAMMPS or of a long chain must be this many times the passing time of
@@ -84,21 +84,6 @@ def check_multiple(path, interval: float, step: float, step_key: str) -> None:
         )
 
 
-def check_passing(config: Mapping, path, duration: float, v0: float, what: str) -> None:
-    """``duration`` (s) >= DURATION_MARGIN x the passing time of the slowest pulse, that
-    of bead 1 launched at ``v0`` (m/s), on every chain; ``what`` names the launch."""
-    worst = slowest_passing(config, v0)
-    needed = DURATION_MARGIN * worst["time_s"]
-    if duration < needed:
-        fail(
-            path,
-            f"{duration:g} s is too short: the slowest wave ({what} at V0 = {v0:g} m/s, Eq. 5 "
-            f"speed {worst['speed_m_s']:.0f} m/s) passes bead {worst['bead']} of the "
-            f"N = {worst['N']} chain at ~{worst['time_s'] * 1e3:.3g} ms; allowed: >= "
-            f"{needed:.3g} s",
-        )
-
-
 def sensor_room(entry: Mapping) -> tuple[float, float]:
     """How far S1 and S2 of a chain sit from its collision point, (N + 1) / 2, beads
     (S1 left of it, S2 right of it; negative when on the wrong side)."""
@@ -149,7 +134,9 @@ def _check_long_chains(config: Mapping) -> None:
     for n in config["long_chains"].get("N", []):
         middle = (n + 1) // 2
         long_chain = {**config, "chains": [{"N": n, "sensors": [middle, middle]}]}
-        check_passing(long_chain, ["long_chains", "duration_s"], duration, v0, what)
+        check_passing(
+            long_chain, ["long_chains", "duration_s"], duration, v0, what, DURATION_MARGIN
+        )
 
 
 def _check_lammps(config: Mapping) -> None:
@@ -162,7 +149,9 @@ def _check_lammps(config: Mapping) -> None:
     check_resolution(config, path, record, fastest, f"bead 1 at {max(speeds):g} m/s")
     duration = options["duration_s"]
     check_samples(["lammps", "duration_s"], duration, record, "lammps.record_interval_s")
-    check_passing(config, ["lammps", "duration_s"], duration, min(speeds), "bead 1 launched")
+    check_passing(
+        config, ["lammps", "duration_s"], duration, min(speeds), "bead 1 launched", DURATION_MARGIN
+    )
 
 
 def _check_setting_names(config: Mapping) -> None:

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 from chain.errors import ConfigError, ParameterError, key_label, nonfinite_paths
 from chain.physics.materials import MATERIALS, get_material
 from chain.physics.theory import force_from_bead_velocity
-from chain.pipeline.config import check_samples, fail, launch_ratios, slowest_passing
+from chain.pipeline.config import check_passing, check_samples, fail, launch_ratios
 from chain.pipeline.config.ablation import check_ablation
 from chain.pipeline.config.virtual import virtual_experiment
 
@@ -166,18 +166,7 @@ def _check_simulation(config: Mapping) -> None:
     if duration is None:
         return
     v0 = config["launch"]["v0_min_m_s"]
-    passing = slowest_passing(config, v0)
-    needed = DURATION_MARGIN * passing["time_s"]
-    if duration < needed:
-        fail(
-            path,
-            f"{duration:g} s is too short: the slowest wave (bead 1 launched at V0 = {v0:g} "
-            f"m/s: F_m ~ {passing['force_N']:.3g} N, Eq. 5 speed {passing['speed_m_s']:.0f} "
-            f"m/s) has passed bead {passing['bead']} of the N = {passing['N']} chain, "
-            f"{passing['distance_m']:.3g} m from its launching end, at "
-            f"~{passing['time_s'] * 1e3:.3g} ms; allowed: >= {DURATION_MARGIN:g} x that = "
-            f"{needed:.3g} s (or faster launches)",
-        )
+    check_passing(config, path, duration, v0, "bead 1 launched", DURATION_MARGIN)
 
 
 def _check_analysis_and_figures(config: Mapping, names: list[str], seen_n) -> None:
