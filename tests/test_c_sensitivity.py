@@ -108,7 +108,7 @@ def test_dissipation_raises_c_and_headline_rows_agree(small_table):
 
 
 def test_spread_summary_and_figure(small_table):
-    spread = c_spread_summary(small_table)
+    spread = c_spread_summary({"table": small_table}, {})
     assert spread["min_us_N16"] <= spread["headline_C_us_N16"] <= spread["max_us_N16"]
     assert "fit_full" in spread["headline_choice"]
     rows = spread_markdown_rows({"c_spread": spread})
@@ -137,8 +137,10 @@ def test_ablation_verdict_names_the_numbers():
         }
     )
     # Printed with the minus sign U+2212 (chain.report.printed); compared as ASCII.
-    verdict = ablation_summary(ablation, fits, "fit_full")["verdict"].replace("\u2212", "-")
+    verdict = ablation_summary({"table": ablation}, {"delay_fits": fits, "estimator": "fit_full"})["verdict"].replace("\u2212", "-")
     for number in ("-0.214", "-0.169", "-0.154", "viscoelastic -0.152"):
         assert number in verdict
-    missing = ablation_summary(ablation.iloc[:1], fits, "fit_full")["verdict"]
+    missing = ablation_summary(
+        {"table": ablation.iloc[:1]}, {"delay_fits": fits, "estimator": "fit_full"}
+    )["verdict"]
     assert missing.startswith("not determined")

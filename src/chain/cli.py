@@ -289,21 +289,20 @@ def _store(args: argparse.Namespace) -> int:
     import os
 
     from chain.pipeline.run import store_admin
-    from chain.pipeline.run.store import DEFAULT_FOLDER, STORE_VARIABLE, Store, StoreError
+    from chain.pipeline.run.store_path import StoreError, open_store
 
     try:
-        store = Store.open(os.environ, create=False)
+        store = open_store(os.environ, create=False)
     except StoreError as error:
         print(f"hertzchain store: error: {error}", file=sys.stderr)
         return 2
-    if store is None:
-        print(f"no result store at {os.environ.get(STORE_VARIABLE) or DEFAULT_FOLDER}")
+    if not os.path.isdir(store):
+        print(f"no result store at {store}")
         return 0
-    with store:
-        if args.action == "prune":
-            lines = store_admin.prune(store, args.results, args.older_than, args.dry_run)
-        else:
-            lines = [store_admin.describe(store)]
+    if args.action == "prune":
+        lines = store_admin.prune(store, args.results, args.older_than, args.dry_run)
+    else:
+        lines = [store_admin.describe(store)]
     print("\n".join(lines))
     return 0
 

@@ -2,7 +2,7 @@
 estimator (params estimator) (chain.studies.ablation_table.ablation_table)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.rows import of_estimator
 from chain.atomic import write_csv_atomic
@@ -16,3 +16,4 @@ fits = {
 table = ablation_table(fits, p.overrides)
 log.info("%d rows", len(table))
 write_csv_atomic(table, snakemake.output[0])
+done(snakemake)

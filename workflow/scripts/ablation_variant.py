@@ -4,7 +4,7 @@ replicate with the run's own settings reads the run's virtual experiment (input
 datasets, where params reads_run says so) instead of simulating it again."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.rows import of_estimator
 from chain.atomic import write_csv_atomic
@@ -33,3 +33,4 @@ for replicate, (chains, reads_run) in enumerate(zip(p.settings, p.reads_run, str
     ssw_tables.append(ssw_fits.assign(replicate=replicate))
 write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output.fits)
 write_csv_atomic(pd.concat(ssw_tables, ignore_index=True), snakemake.output.ssw_fits)
+done(snakemake)

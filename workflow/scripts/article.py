@@ -2,7 +2,7 @@
 
 import json
 
-from _logging import start
+from _logging import done, start
 
 from chain.report.text.article import article_numbers, compile_article
 
@@ -13,3 +13,4 @@ p = snakemake.params
 numbers = article_numbers(summary, setup=p.setup, provenance=p.provenance)
 compile_article(snakemake.input.source, numbers, snakemake.input.figures, snakemake.output[0])
 log.info("claims: %s", [(c["claim"], c["agrees"]) for c in numbers["claims"]])
+done(snakemake)

@@ -2,7 +2,7 @@
 (chain.studies.c_sensitivity), on simulated shots, with each estimator as the headline
 one (rule c_sensitivity_table writes the main one's as tables/c_sensitivity.csv)."""
 
-from _logging import start
+from _logging import done, start
 
 from chain.apparatus.shots import simulate_shots
 from chain.atomic import write_csv_atomic
@@ -25,3 +25,4 @@ columns = ["main_estimator", "choice", "value", "C", "C_stderr", "exponent"]
 for row in table[table["N"].astype(str) == "pooled"][columns].itertuples(index=False):
     log.info("headline %s; %s = %s: C = %.2f +- %.2f, p = %.4f", *row)
 write_csv_atomic(table, snakemake.output[0])
+done(snakemake)

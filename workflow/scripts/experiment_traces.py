@@ -1,7 +1,7 @@
 """Every experiment dataset (measured-trace format) as a trace table (chain.apparatus.measured)."""
 
 from _inputs import dataset_folders
-from _logging import start
+from _logging import done, start
 
 from chain.apparatus.measured import load_dataset
 from chain.traces import write_traces
@@ -21,4 +21,4 @@ for dataset, folder, traces in zip(p.datasets, dataset_folders(snakemake), snake
         *(folder, traces, *counts, shots["amplitude"].nunique()),
     )
     write_traces(table, traces)  # atomic: temporary file, then rename
-log.info("done")
+done(snakemake)

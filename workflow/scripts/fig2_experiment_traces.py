@@ -3,7 +3,7 @@
 
 import pandas as pd
 from _inputs import selection
-from _logging import start
+from _logging import done, start
 
 from chain.report.figures.fig2_experiment_traces import fig2_experiment_traces
 from chain.report.figures.style import save_figure
@@ -22,4 +22,4 @@ fig = fig2_experiment_traces(
     selection=selection(snakemake),
 )
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
-log.info("done")
+done(snakemake)

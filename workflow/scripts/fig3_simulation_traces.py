@@ -1,7 +1,7 @@
 """Fig. 3: simulated forces at the sensor beads (chain.report.figures.fig3_simulation_traces)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.report.figures.fig3_simulation_traces import fig3_simulation_traces
 from chain.report.figures.style import save_figure
@@ -21,4 +21,4 @@ fig = fig3_simulation_traces(
     label=p.label,
 )
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
-log.info("done")
+done(snakemake)

@@ -1,7 +1,7 @@
 """Fig. 4: |Delta| against F_m (chain.report.figures.fig4_delay_vs_force)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.physics.theory import ballistic_constants
 from chain.report.figures.fig4_delay_vs_force import fig4_delay_vs_force
@@ -15,4 +15,4 @@ fig = fig4_delay_vs_force(
     delays, fits, constants=constants, estimator=p.estimator, experiment_label=p.experiment_label
 )
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
-log.info("done")
+done(snakemake)

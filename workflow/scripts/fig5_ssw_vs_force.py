@@ -2,7 +2,7 @@
 the chain (chain.report.figures.fig5_ssw_vs_force)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.ssw_track import sensor_distance
 from chain.report.figures.fig5_ssw_vs_force import fig5_ssw_vs_force
@@ -16,4 +16,4 @@ fig = fig5_ssw_vs_force(
     experiment_label=p.experiment_label,
 )
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
-log.info("done")
+done(snakemake)

@@ -1,7 +1,7 @@
 """What-if figure: SSW slope against N, odd and even (chain.report.figures.fig_parity_ssw_vs_N)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.report.figures.fig_parity_ssw_vs_N import fig_parity_ssw_vs_N
 from chain.report.figures.style import save_figure
@@ -11,4 +11,4 @@ fig = fig_parity_ssw_vs_N(
     pd.read_csv(snakemake.input.fits), experiment_label=snakemake.params.experiment_label
 )
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
-log.info("done")
+done(snakemake)

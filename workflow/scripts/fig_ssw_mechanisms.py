@@ -2,7 +2,7 @@
 (chain.report.figures.fig_ssw_mechanisms)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.report.figures.fig_ssw_mechanisms import fig_ssw_mechanisms
 from chain.report.figures.style import save_figure
@@ -10,4 +10,4 @@ from chain.report.figures.style import save_figure
 log = start(snakemake)
 fig = fig_ssw_mechanisms(pd.read_csv(snakemake.input.table))
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"))
-log.info("done")
+done(snakemake)

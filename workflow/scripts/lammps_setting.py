@@ -1,7 +1,7 @@
 """One friction/rotation setting on one chain, run by LAMMPS and analysed
 (chain.studies.lammps_sweep.run_sweep_setting), with every estimator of the run."""
 
-from _logging import start
+from _logging import done, start
 
 from chain.atomic import write_csv_atomic
 from chain.studies.lammps_sweep import run_sweep_setting
@@ -15,3 +15,4 @@ for name in ("runs", "delay_fits", "ssw_fits"):
     write_csv_atomic(out[name], snakemake.output[name])
 spin, slopes = out["runs"]["max_spin_rad_s"].max(), out["ssw_fits"]["slope"].tolist()
 log.info("%s N = %s: largest bead spin %.3g rad/s; SSW slopes %s", w.setting, w.N, spin, slopes)
+done(snakemake)

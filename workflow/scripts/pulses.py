@@ -1,7 +1,7 @@
 """Fit the pulses of every trace file (chain.analysis.pulse_rows.pulse_table)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.pulse_rows import pulse_table
 from chain.atomic import write_csv_atomic
@@ -16,3 +16,4 @@ for path in snakemake.input.traces:
     log.info("%s: %d pulse rows, %d not ok", path, len(table), int((~table["ok"]).sum()))
     tables.append(table)
 write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output[0])
+done(snakemake)

@@ -2,7 +2,7 @@
 
 import pandas as pd
 from _inputs import dataset_folders
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.selection import select_shots
 from chain.apparatus.dataset_check import check_dataset
@@ -33,3 +33,4 @@ for (model, n, kind), kept in table.groupby(["model", "N", "kind"])["kept"]:
 for row in table[~table["kept"]].itertuples():
     log.info("rejected %s N = %s shot %s: %s", row.model, row.N, row.shot, row.reason)
 write_csv_atomic(table, snakemake.output[0])
+done(snakemake)

@@ -1,6 +1,6 @@
 """Simulate one model on one chain for every launch speed (chain.apparatus.shots)."""
 
-from _logging import start
+from _logging import done, start
 
 from chain.apparatus.shots import simulate_shots
 from chain.atomic import write_csv_atomic
@@ -15,4 +15,4 @@ traces, runs = simulate_shots(*args, model_name=job["model"], **simulation_kwarg
 log.info("dt = %g s, largest energy drift %.3g", runs["dt_s"].iloc[0], runs["energy_drift"].max())
 write_traces(traces, snakemake.output.traces)
 write_csv_atomic(runs, snakemake.output.runs)
-log.info("done")
+done(snakemake)

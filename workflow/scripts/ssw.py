@@ -2,7 +2,7 @@
 
 import pandas as pd
 from _inputs import selection
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.ssw import ssw_table
 from chain.atomic import write_csv_atomic
@@ -18,3 +18,4 @@ for path in snakemake.input.traces:
     log.info("%s: %d SSW rows", path, len(table))
     tables.append(table)
 write_csv_atomic(pd.concat(tables, ignore_index=True), snakemake.output[0])
+done(snakemake)

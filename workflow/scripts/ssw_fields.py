@@ -4,7 +4,7 @@ only, at the time step of ssw_track's whole batch (the same numbers bit for bit)
 that a figure key recomputes milliseconds of integration, not the tracks."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.ssw_track import field_table, representative_shot
 from chain.apparatus.shots import shot_time_step
@@ -33,4 +33,4 @@ for job, track_file, field_file in zip(p.jobs, snakemake.input.tracks, snakemake
     )
     write_csv_atomic(field_table(result.time, result.contact_force[0], shot=shot), field_file)
     log.info("%s N = %d: field of shot %d written", job["model"], job["N"], shot)
-log.info("done")
+done(snakemake)

@@ -1,7 +1,7 @@
 """Fits of SSW amplitude = slope x F_m (chain.analysis.ssw.ssw_fit_table)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.rows import flag_unusable
 from chain.analysis.ssw_fits import ssw_fit_table
@@ -15,3 +15,4 @@ ssw = flag_unusable(ssw, ["F_m_N", "ssw_N"], "SSW rows (residual)", where=fitted
 table = ssw_fit_table(ssw)
 log.info("%d fits", len(table))
 write_csv_atomic(table, snakemake.output[0])
+done(snakemake)

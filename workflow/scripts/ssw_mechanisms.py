@@ -3,16 +3,12 @@ estimator) per mechanism and setting: the LAMMPS friction/rotation sweep and the
 experiment's candidates (chain.studies.mechanism_table)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.rows import of_estimator
 from chain.atomic import write_csv_atomic
-from chain.studies.mechanism_table import (
-    FRICTION_MECHANISM,
-    VISCOUS_MECHANISM,
-    candidate_rows,
-    mechanism_rows,
-)
+from chain.labels import FRICTION_MECHANISM, VISCOUS_MECHANISM
+from chain.studies.mechanism_table import candidate_rows, mechanism_rows
 
 log = start(snakemake)
 p, i = snakemake.params, snakemake.input
@@ -44,3 +40,4 @@ if p.candidates:
 table = pd.concat(tables, ignore_index=True)
 log.info("%d rows", len(table))
 write_csv_atomic(table, snakemake.output[0])
+done(snakemake)

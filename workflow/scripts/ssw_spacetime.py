@@ -1,7 +1,7 @@
 """Figure ssw_spacetime: the SSW along the chain (chain.report.figures.fig_ssw_spacetime)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.report.figures.fig_ssw_spacetime import fig_ssw_spacetime
 from chain.report.figures.style import save_figure
@@ -15,4 +15,4 @@ fig = fig_ssw_spacetime(fields, pd.read_csv(i.track), p.model, long_fields)
 # The PNG drawn in a forked process beside the PDF, whatever the threads of the job (a
 # local run schedules it on one core, profiles/default); the fork lives for the save.
 save_figure(fig, snakemake.output.pdf.removesuffix(".pdf"), processes=2)
-log.info("done")
+done(snakemake)

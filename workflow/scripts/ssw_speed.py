@@ -2,7 +2,7 @@
 (chain.analysis.ssw_speed.ssw_speed_table)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.ssw_speed import ssw_speed_table
 from chain.atomic import write_csv_atomic
@@ -19,3 +19,4 @@ speed = ssw_speed_table(
 log.info("%d speed rows", len(speed))
 write_csv_atomic(track, snakemake.output.track)
 write_csv_atomic(speed, snakemake.output.speed)
+done(snakemake)

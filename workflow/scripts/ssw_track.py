@@ -1,7 +1,7 @@
 """Re-simulate one chain's collisions with every contact recorded and track the SSW
 (chain.analysis.ssw_track). The field Fig. ssw_spacetime shows: ssw_fields.py."""
 
-from _logging import start
+from _logging import done, start
 
 from chain.analysis.ssw_track import ssw_track_table
 from chain.apparatus.shots import shot_time_step
@@ -30,4 +30,4 @@ result = simulate(
 track = ssw_track_table(result.time, result.contact_force, source="simulation", model=job["model"])
 log.info("%d of %d contacts separated", track["separated"].sum(), len(track))
 write_csv_atomic(track, snakemake.output.track)
-log.info("done")
+done(snakemake)

@@ -1,12 +1,14 @@
-"""summary.json: the run's numbers beside the paper's (chain.report.numbers.summary)."""
+"""summary.json: the run's numbers beside the paper's (chain.report.numbers.summary),
+with the sections the studies add (each part's function of its tables, as its rule file
+names it: params.parts)."""
+
+import importlib
 
 import pandas as pd
 from _inputs import selection
-from _logging import start
+from _logging import done, start
 
 from chain.report.numbers.claims import with_claims
-from chain.report.numbers.mechanisms import mechanism_summary
-from chain.report.numbers.spread import ablation_summary, c_spread_summary
 from chain.report.numbers.summary import build_summary, write_summary_json
 
 log = start(snakemake)
@@ -29,19 +31,12 @@ summary = build_summary(
     tolerance=p.tolerance if i.get("selection") else None,
     ssw_speed=pd.read_csv(i.ssw_speed),
 )
-# The ablation verdict (with the virtual experiment) and the spread of C over our choices.
-if i.get("ablation"):
-    summary["ablation"] = ablation_summary(pd.read_csv(i.ablation[0]), delay_fits, p.estimator)
-if i.get("c_sensitivity"):
-    summary["c_spread"] = c_spread_summary(pd.read_csv(i.c_sensitivity[0]))
-# The mechanism study's verdict (LAMMPS rows only where LAMMPS is installed).
-if i.get("mechanisms"):
-    summary["ssw_mechanisms"] = mechanism_summary(
-        pd.read_csv(i.mechanisms[0]),
-        pd.read_csv(i.lammps_check[0]) if i.get("lammps_check") else None,
-        friction=p.friction_mechanism,
-        reference=p.reference_mechanism,
-    )
+# The studies' sections (the ablation verdict, the spread of C, the mechanisms'...).
+run = {"delay_fits": delay_fits, "estimator": p.estimator}
+for part, (function, names) in p.parts.items():
+    module, name = function.split(":")
+    tables = {table: pd.read_csv(i[f"{part}__{table}"]) for table in names}
+    summary[part] = getattr(importlib.import_module(module), name)(tables, run)
 # The studies switched off by the config (key absent when all ran).
 if p.studies_not_run:
     summary["studies_not_run"] = list(p.studies_not_run)
@@ -52,3 +47,4 @@ write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])
 log.info("selection: %s", summary["selection"])
+done(snakemake)

@@ -2,7 +2,7 @@
 (chain.studies.sweep.sweep_table)."""
 
 import pandas as pd
-from _logging import start
+from _logging import done, start
 
 from chain.atomic import write_csv_atomic
 from chain.studies.sweep import sweep_table
@@ -12,3 +12,4 @@ fits = pd.read_csv(snakemake.input.delay_fits), pd.read_csv(snakemake.input.ssw_
 table = sweep_table(*fits, snakemake.params.eta_s, snakemake.params.estimator)
 log.info("%d rows (models x chains)", len(table))
 write_csv_atomic(table, snakemake.output[0])
+done(snakemake)

@@ -1,7 +1,7 @@
 """The virtual experiment on one chain (chain.apparatus.virtual.run_virtual_experiment): a
 model of the apparatus writing a dataset in the measured-trace format (not data)."""
 
-from _logging import start
+from _logging import done, start
 
 from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
 
@@ -17,4 +17,4 @@ log.info(
 )
 # Written to a temporary folder that then replaces the output folder: all or nothing.
 run_virtual_experiment(settings, snakemake.output[0], snakemake.params.dataset)
-log.info("done")
+done(snakemake)

@@ -13,20 +13,13 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from chain.labels import REFERENCE_MECHANISM
+
 #: Columns of ``tables/ssw_mechanisms.csv`` (the results contract).
 MECHANISM_COLUMNS = tuple(
     "mechanism setting N ssw_over_Fm ssw_over_Fm_err ratio_to_frictionless C C_stderr".split()
 )
 
-#: Mechanism name of the LAMMPS friction/rotation rows.
-FRICTION_MECHANISM = "rotation + friction (LAMMPS)"
-
-#: Mechanism name of the LAMMPS rows with a viscous inter-bead force instead of
-#: Kuwabara-Kono (on the frictionless track).
-VISCOUS_MECHANISM = "viscous inter-bead term (LAMMPS)"
-
-#: Mechanism name of the candidates' reference row.
-REFERENCE_MECHANISM = "reference (virtual experiment as configured)"
 
 
 def mechanism_rows(

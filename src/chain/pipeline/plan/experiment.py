@@ -1,10 +1,8 @@
-"""The experiment's part of the plan: its traces in the trace format, and the paper's
-acceptance protocol on them. With ``experiment.source: virtual``, ``virtual_experiment``
-writes each chain's dataset in the measured format (a MODEL of the apparatus); with
-``measured``, the datasets of ``experiment.datasets`` are read instead; with ``none``
-nothing here runs and Fig. 2 is not drawn. ``experiment_traces`` loads the datasets,
-``selection`` applies the 5 % amplitude match (``experiment/selection.csv``), which the
-delay and SSW tables use to drop rejected collision shots.
+"""The experiment's facts: its chains and where their traces come from. With
+``experiment.source: virtual``, the virtual experiment writes each chain's dataset in
+the measured format (a MODEL of the apparatus); with ``measured``, the datasets of
+``experiment.datasets`` are read instead (and checked before any job); with ``none``
+there is no experiment and Fig. 2 is not drawn.
 """
 
 from __future__ import annotations
@@ -18,14 +16,23 @@ from chain.pipeline.plan.datasets import (
     DEFAULT_CACHE,
     ExperimentPart,
     bad_channel_policy,
+    check_experiment_datasets,
     experiment_label,
     experiment_parts,
 )
-from chain.pipeline.plan.steps import Part, Step
 
 
-class ExperimentPlan(Part):
-    """The virtual_experiment, experiment_traces and selection steps of a run."""
+class ExperimentPlan:
+    """The facts of the virtual_experiment, experiment_traces and selection jobs.
+
+    Parameters
+    ----------
+    plan : RunPlan
+        The run's plan, whose shared facts it reads.
+    """
+
+    def __init__(self, plan):
+        self.plan = plan
 
     @cached_property
     def chains(self) -> tuple[ExperimentPart, ...]:
@@ -59,72 +66,39 @@ class ExperimentPlan(Part):
         """The virtual experiment of the chain of N beads (:meth:`settings`)."""
         return VirtualExperiment(**self.settings(n_beads))
 
-    def raw_dataset(self, n_beads: int) -> str:
-        """Folder of the virtual experiment's dataset of the chain of N beads."""
-        return f"{self.plan.out}/experiment/raw/N{int(n_beads)}"
+    @property
+    def virtual_n(self) -> list[int]:
+        """N of each chain the virtual experiment runs (none for measured datasets)."""
+        return [part.n_beads for part in self.chains if part.folder is None]
 
     @property
-    def parts(self) -> list[tuple[str, str, int]]:
-        """(source, name, N) of each experiment trace file."""
-        return [("experiment", part.name, part.n_beads) for part in self.chains]
+    def measured_files(self) -> list[str]:
+        """Every file of the measured datasets (``metadata.yaml`` and the shots)."""
+        return [path for part in self.chains if part.folder is not None for path in part.files]
 
-    def trace_files(self, shown: tuple[int, ...] = ()) -> list[str]:
-        """The experiment's trace files; with ``shown``, those of these N (all if none)."""
-        files = [(n, f"{self.plan.out}/experiment/{name}_N{n}_traces.csv")
-                 for _, name, n in self.parts]  # fmt: skip
-        return [f for n, f in files if n in shown] or [f for _, f in files]
+    @property
+    def trace_files(self) -> dict[str, str]:
+        """Output name -> file name of each chain's trace file (``series<i>``)."""
+        return {f"series{i}": f"experiment/{part.name}_N{part.n_beads}_traces.csv"
+                for i, part in enumerate(self.chains)}  # fmt: skip
 
-    def selection_files(self) -> list[str]:
-        """``[experiment/selection.csv]`` when the run has an experiment, else ``[]``."""
-        return [f"{self.plan.out}/experiment/selection.csv"] if self.chains else []
+    def shown(self, chains: tuple[int, ...] = ()) -> list[str]:
+        """Output names of the trace files of the chains ``chains`` (all if none are)."""
+        names = [name for name, part in zip(self.trace_files, self.chains, strict=True)
+                 if part.n_beads in chains]  # fmt: skip
+        return names or list(self.trace_files)
 
-    def _datasets(self) -> dict:
-        """The inputs and parameters that load the datasets: the virtual experiment's
-        folders as inputs (a path naming the run in a parameter would make every run's
-        result its own), each measured dataset's files, and the policy on bad channels."""
+    @property
+    def loading(self) -> dict:
+        """The params that load the datasets: each dataset (measured folder or None, series
+        name, N), the policy on bad channels and the dataset check's cache."""
         return {
-            "virtual": [self.raw_dataset(p.n_beads) for p in self.chains if p.folder is None],
-            "measured": [path for p in self.chains if p.folder is not None for path in p.files],
             "datasets": [{"folder": p.folder, "name": p.name, "N": p.n_beads} for p in self.chains],
             "bad_channels": bad_channel_policy(self.plan.config),
             "cache": str(DEFAULT_CACHE),
         }
 
-    def steps(self) -> list[Step]:
-        """virtual_experiment, experiment_traces, selection."""
-        if not self.chains:
-            return []
-        plan, out, d = self.plan, self.plan.out, self._datasets()
-        load = {k: d[k] for k in ("datasets", "bad_channels", "cache")}
-        virtual = [{"N": p.n_beads} for p in self.chains if p.folder is None]
-        return [
-            # ~1.3 s of integration per chain: a second core would shorten it by less
-            # than the job another core runs meanwhile.
-            Step(
-                "virtual_experiment", {"0": f"{out}/experiment/raw/N{{N}}"}, jobs=virtual,
-                params=lambda w: {"settings": self.settings(w["N"]), "dataset": self.series},
-                log=f"{out}/logs/experiment/virtual_N{{N}}.log", folders=("0",), priority=3,
-                resources={"mem_mb": 1000, "runtime": 30},  # MB (270 peak); minutes
-            ),
-            # One job loads every dataset: a job costs more start-up than a load.
-            Step(
-                "experiment_traces",
-                {str(i): path for i, path in enumerate(self.trace_files())},
-                inputs=lambda w: {"virtual": d["virtual"], "measured": d["measured"]},
-                params=lambda w: load,
-                log=f"{out}/logs/experiment/traces.log", priority=3,
-            ),
-            Step(
-                "selection", {"0": self.selection_files()[0]},
-                inputs=lambda w: {
-                    "pulses": f"{plan.tables}/pulses.csv", "traces": self.trace_files(),
-                    "virtual": d["virtual"], "measured": d["measured"],
-                },
-                params=lambda w: {
-                    "tolerance": plan.config["experiment"]["tolerance"],
-                    "estimator": plan.config["analysis"]["main_estimator"], **load,
-                },
-                log=f"{out}/logs/experiment/selection.log", priority=2,
-                report={"0": ("selection.rst", "Tables")},
-            ),
-        ]  # fmt: skip
+    def check_datasets(self) -> None:
+        """Check every shot file of every measured dataset: all problems at once, before
+        any job (:func:`chain.pipeline.plan.datasets.check_experiment_datasets`)."""
+        check_experiment_datasets(self.plan.config, list(self.chains), root=self.plan.root)

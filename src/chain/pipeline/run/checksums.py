@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from chain.atomic import write_text_atomic
-from chain.pipeline.run.store import file_digest
+from chain.pipeline.run.entries import file_digest
 
 #: The checksum file of a run folder.
 CHECKSUMS = "SHA256SUMS"

@@ -1,113 +1,88 @@
 """``hertzchain store``: what the result store holds, and pruning it.
 
-An entry is held by a run folder (``results/<run_name>``) when that folder's
-``SHA256SUMS`` lists every file of the entry's outputs, at the path the manifest
-records (``paths``, relative to the run folder) and with the stored SHA-256: the run
-shows those very bytes. A run folder without ``SHA256SUMS`` (a run going on, or one
-that failed before its end) holds nothing. Pruning removes what no run folder holds,
-and with a date, what was stored before it whether held or not; each entry goes
-through :meth:`chain.pipeline.run.store.Store.discard` (renamed away, then deleted).
+An entry is held by a run folder (``results/<run_name>``) when the folder shows one of
+its files (its ``SHA256SUMS`` lists the same SHA-256) or the entry is upstream of one
+that it shows (:func:`chain.pipeline.run.publish.upstream`). A run folder without
+``SHA256SUMS`` (a run going on, or one that failed before its end) holds nothing.
+Pruning removes what no run folder holds, and with a date, what was stored before it
+whether held or not.
 """
 
 from __future__ import annotations
 
 import datetime
+import os
 from pathlib import Path
 
 from chain.pipeline.run.checksums import CHECKSUMS
-from chain.pipeline.run.store import Store
+from chain.pipeline.run.entries import ENTRY, SUMS, discard, read_sums
+from chain.pipeline.run.publish import upstream
 
 
-def describe(store: Store) -> str:
-    """One line: the store's folder, its number of entries and their size.
-
-    Parameters
-    ----------
-    store : Store
-    """
-    sizes = [size for _, _, size in store.entries()]
-    return f"result store {store.root}: {len(sizes)} entries, {_bytes(sum(sizes))}"
-
-
-def run_checksums(results: str | Path) -> list[dict[str, str]]:
-    """Each run folder's ``SHA256SUMS``, as path (relative to the run folder) -> SHA-256.
-
-    Parameters
-    ----------
-    results : path
-        The folder of the run folders (``results``); hidden folders (the store) skipped.
-    """
+def entries(store: str | Path) -> list[tuple[Path, int]]:
+    """(folder, size in bytes) of each sealed entry of the store, sorted."""
     found = []
-    for sums in sorted(Path(results).glob(f"[!.]*/{CHECKSUMS}")):
-        listed = {}
-        for line in sums.read_text().splitlines():
-            digest, _, path = line.partition("  ")
-            listed[path] = digest
-        found.append(listed)
+    root = Path(store)
+    for entry in sorted(root.iterdir()) if root.is_dir() else []:
+        if ENTRY.match(entry.name) and (entry / SUMS).is_file():
+            size = sum(p.lstat().st_size for p in entry.rglob("*") if p.is_file())
+            found.append((entry, size))
     return found
 
 
-def held(manifest: dict | None, checksums: list[dict[str, str]]) -> bool:
-    """Whether a run folder shows every file of the entry of ``manifest``.
-
-    Parameters
-    ----------
-    manifest : dict or None
-        The entry's manifest (None: unreadable, held by none).
-    checksums : list of dict
-        :func:`run_checksums`.
-    """
-    try:
-        files = {
-            f"{path}/{name}" if name else str(path): sha256
-            for path, record in zip(manifest["paths"], manifest["outputs"], strict=True)
-            for name, (sha256, _) in record.items()
-        }
-    except (TypeError, KeyError, ValueError):
-        return False
-    return any(all(listed.get(p) == d for p, d in files.items()) for listed in checksums)
+def describe(store: str | Path) -> str:
+    """One line: the store's folder, its number of entries and their size."""
+    sizes = [size for _, size in entries(store)]
+    return f"result store {store}: {len(sizes)} entries, {_bytes(sum(sizes))}"
 
 
-def prune(store: Store, results: str | Path, older_than=None, dry_run=False) -> list[str]:
+def held(store: str | Path, results: str | Path) -> set[Path]:
+    """The entries some run folder under ``results`` holds (see the module's docstring)."""
+    shown = set()
+    for sums in Path(results).glob(f"[!.]*/{CHECKSUMS}"):
+        shown |= {line.partition("  ")[0] for line in sums.read_text().splitlines()}
+    showing = {entry for entry, _ in entries(store)
+               if any(d in shown for n, d in _own(entry).items())}  # fmt: skip
+    return set(upstream(showing))
+
+
+def _own(entry: Path) -> dict[str, str]:
+    return {name: d for name, d in read_sums(entry).items() if not name.startswith("../")}
+
+
+def prune(store: str | Path, results: str | Path, older_than=None, dry_run=False) -> list[str]:
     """Remove the entries no run folder under ``results`` holds, and those stored before
     ``older_than`` whether held or not. Returns the console lines: one per entry
     removed, then the count and the bytes freed.
 
     Parameters
     ----------
-    store : Store
+    store : path
+        The store's folder.
     results : path
         The folder of the run folders.
     older_than : datetime.date or None
-        Entries stored (the manifest's ``stored``) before this day go too.
+        Entries stored (sealed) before this day go too.
     dry_run : bool
         Say what would go and remove nothing.
     """
-    checksums = run_checksums(results)
+    keep = held(store, results)
     lines, freed, kept = [], 0, 0
-    for key, manifest, size in list(store.entries()):
-        stored = _stored(manifest)
-        if older_than is not None and stored is not None and stored < older_than:
+    for entry, size in entries(store):
+        stored = datetime.date.fromtimestamp(os.stat(entry / SUMS).st_mtime)
+        if older_than is not None and stored < older_than:
             why = f"stored {stored}, before {older_than}"
-        elif not held(manifest, checksums):
+        elif entry not in keep:
             why = f"held by no run folder under {results}"
         else:
             kept += 1
             continue
-        job = (manifest or {}).get("job", "?")
-        lines.append(f"  {key[:12]}  {job}  {_bytes(size)}  ({why})")
+        lines.append(f"  {entry.name}  {_bytes(size)}  ({why})")
         freed += size
         if not dry_run:
-            store.discard(key)
+            discard(entry)
     done = ("would remove", "freeing") if dry_run else ("removed", "freed")
     return [*lines, f"{done[0]} {len(lines)} entries, {done[1]} {_bytes(freed)}; {kept} kept"]
-
-
-def _stored(manifest: dict | None) -> datetime.date | None:
-    try:
-        return datetime.datetime.fromisoformat(manifest["stored"]).date()
-    except (TypeError, KeyError, ValueError):
-        return None
 
 
 def _bytes(count: int) -> str:

@@ -28,12 +28,14 @@ import stat
 from pathlib import Path
 
 from chain.atomic import ordinary_mode
-from chain.pipeline.run.staging import FOLDER_FLAGS
+from chain.pipeline.run.entries import GROUP_VARIABLE
 
 #: Environment variable naming the store's folder.
 STORE_VARIABLE = "HERTZCHAIN_STORE"
-#: Environment variable naming the one group the store is shared with, if any.
-GROUP_VARIABLE = "HERTZCHAIN_STORE_GROUP"
+#: The store's folder relative to the working directory: ``rm -r results`` empties it.
+DEFAULT_FOLDER = "results/.store"
+#: A folder, opened without following a link.
+FOLDER_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
 #: File systems whose owners and modes need not be the accounts' own (and ``fuse.*``).
 FOREIGN_OWNERS = frozenset(
     {"nfs", "nfs4", "cifs", "smb3", "smbfs", "9p", "vfat", "exfat", "msdos", "ntfs", "ntfs3"}
@@ -42,6 +44,36 @@ FOREIGN_OWNERS = frozenset(
 
 class StoreError(RuntimeError):
     """The store cannot be used safely; the message names its folder."""
+
+
+def open_store(environ, trusted=(), create: bool = True) -> str:
+    """The store's folder as the rules name its files: :data:`STORE_VARIABLE` (relative
+    to the working directory), else :data:`DEFAULT_FOLDER`; its whole path checked
+    (:func:`open_store_folder`), and made if missing when ``create``.
+
+    Parameters
+    ----------
+    environ : mapping
+        The process environment.
+    trusted : sequence of Path
+        Folders that hold the code the run executes (the checkout, the working folder).
+    create : bool
+        Make what is missing. False writes nothing (a dry run).
+
+    Raises
+    ------
+    StoreError
+        A folder of its path is not safe, or it cannot be made; the message names the
+        folder and the fix.
+    """
+    root = environ.get(STORE_VARIABLE) or DEFAULT_FOLDER
+    if "{" in root or "}" in root:
+        raise StoreError(f"{STORE_VARIABLE}={root}: a folder name with braces cannot be used")
+    group = group_id(environ.get(GROUP_VARIABLE))
+    fd = open_store_folder(Path(root), create, 0o700 if group is None else 0o2770, group)
+    if fd is not None:
+        os.close(fd)
+    return root
 
 
 def group_id(name: str | None) -> int | None:

@@ -9,6 +9,8 @@ from collections.abc import Mapping
 
 import pandas as pd
 
+from chain.labels import FRICTION_MECHANISM, REFERENCE_MECHANISM
+
 #: A ratio to the frictionless (or candidate-off) value that counts as "significantly
 #: larger" (the verdict and the mechanism figure's dotted mark).
 SIGNIFICANT_RATIO = 2.0
@@ -153,23 +155,21 @@ def _contrast(rows: pd.DataFrame) -> str:
     return f"{by_n[26] / by_n[25]:.2f}"
 
 
-def mechanism_summary(
-    table: pd.DataFrame, check: pd.DataFrame | None, *, friction: str, reference: str
-) -> dict:
-    """``{"verdict": two sentences, "rows": the table, "lammps_check": its rows,
-    "friction_C": C with and without friction}`` (:func:`friction_c_rows`).
+def mechanism_summary(tables: Mapping[str, pd.DataFrame], run: Mapping) -> dict:
+    """The mechanism study's section of summary.json: ``{"verdict": two sentences,
+    "rows": the table, "lammps_check": its rows, "friction_C": C with and without
+    friction}`` (:func:`friction_c_rows`).
 
     Parameters
     ----------
-    table : DataFrame
-        ``ssw_mechanisms.csv``.
-    check : DataFrame or None
-        ``lammps_check.csv`` (None without LAMMPS).
-    friction : str
-        The ``mechanism`` of the LAMMPS friction/rotation rows.
-    reference : str
-        The ``mechanism`` of the candidates' reference row.
+    tables : mapping
+        ``{"table": ssw_mechanisms.csv}``, and ``lammps_check`` (lammps_check.csv) when
+        LAMMPS ran.
+    run : mapping
+        The run's tables (unused).
     """
+    table, check = tables["table"], tables.get("lammps_check")
+    friction, reference = FRICTION_MECHANISM, REFERENCE_MECHANISM
     verdict = (
         f"{friction_sentence(table, friction)}. {candidate_sentence(table, friction, reference)}."
     )

@@ -10,6 +10,7 @@ but the selection of rows and the wording.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import pandas as pd
 
@@ -33,18 +34,19 @@ def _records(table: pd.DataFrame) -> list[dict]:
     ]
 
 
-def ablation_summary(ablation: pd.DataFrame, delay_fits: pd.DataFrame, estimator: str) -> dict:
-    """``{"verdict": one sentence with the numbers, "rows": the table's rows}``.
+def ablation_summary(tables: Mapping[str, pd.DataFrame], run: Mapping) -> dict:
+    """The ablation's section of summary.json: ``{"verdict": one sentence with the
+    numbers, "rows": the table's rows}``.
 
     Parameters
     ----------
-    ablation : DataFrame
-        ``ablation_exponent.csv``.
-    delay_fits : DataFrame
-        ``delay_fits.csv`` (the run's own virtual experiment: the configured variant).
-    estimator : str
-        The main estimator.
+    tables : mapping
+        ``{"table": ablation_exponent.csv}``.
+    run : mapping
+        The run's ``delay_fits`` (its own virtual experiment: the configured variant)
+        and main ``estimator``.
     """
+    ablation, delay_fits, estimator = tables["table"], run["delay_fits"], run["estimator"]
     run = delay_fits[
         (delay_fits["source"] == "experiment")
         & (delay_fits["N"].astype(str) == "pooled")
@@ -82,10 +84,12 @@ def ablation_summary(ablation: pd.DataFrame, delay_fits: pd.DataFrame, estimator
     return {"verdict": verdict, "rows": _records(ablation)}
 
 
-def c_spread_summary(table: pd.DataFrame) -> dict:
-    """``{"headline_choice", "min_us_N16", "max_us_N16", "rows"}`` from
-    ``c_sensitivity.csv``: the headline choice in words and the range of the pooled C
-    over every choice whose chains all gave delays."""
+def c_spread_summary(tables: Mapping[str, pd.DataFrame], run: Mapping) -> dict:
+    """The C sensitivity's section of summary.json: ``{"headline_choice", "min_us_N16",
+    "max_us_N16", "rows"}`` from ``{"table": c_sensitivity.csv}``: the headline choice
+    in words and the range of the pooled C over every choice whose chains all gave
+    delays (``run``, the run's tables, unused)."""
+    table = tables["table"]
     pooled = _pooled(table)
     head = pooled[pooled["headline"].astype(bool)].iloc[0]
     # Pooled rows missing a chain are not comparable with the headline.

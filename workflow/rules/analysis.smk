@@ -1,0 +1,152 @@
+# The analysis: pulses (cos^6 fits) of every trace file, then the crossing delays, the
+# secondary solitary waves (SSW) and their fits, and the SSW along the chain, as the
+# contract tables. Well under a second per trace file: each table is one job.
+
+
+def trace_files(wildcards=None):
+    """Every trace file the analysis reads: the simulation's, then the experiment's."""
+    simulated = [
+        output_of("simulate", "traces", model=m, N=n) for m in PLAN.models for n in PLAN.chains
+    ]
+    return simulated + experiment_trace_files()
+
+
+rule pulses:
+    input:
+        traces=trace_files,
+    output:
+        table=report(
+            stored("pulses", "tables/pulses.csv"),
+            caption="../report/pulses.rst",
+            category="Tables",
+        ),
+        sums=stored("pulses", "SHA256SUMS"),
+    log:
+        stored("pulses", "log"),
+    benchmark:
+        stored("pulses", "benchmark.tsv")
+    params:
+        estimators=config["analysis"]["estimators"],
+    priority: 2
+    resources:
+        mem_mb=1000,  # MB (185 peak)
+        runtime=30,  # minutes (~2 s per trace file)
+    conda:
+        ENV
+    script:
+        "../scripts/pulses.py"
+
+
+rule delays:
+    input:
+        pulses=made("pulses", "table"),
+        selection=selection_files,
+    output:
+        table=stored("delays", "tables/delays.csv"),
+        sums=stored("delays", "SHA256SUMS"),
+    log:
+        stored("delays", "log"),
+    benchmark:
+        stored("delays", "benchmark.tsv")
+    priority: 1
+    conda:
+        ENV
+    script:
+        "../scripts/delays.py"
+
+
+rule delay_fits:
+    input:
+        delays=made("delays", "table"),
+    output:
+        table=report(
+            stored("delay_fits", "tables/delay_fits.csv"),
+            caption="../report/delay_fits.rst",
+            category="Tables",
+        ),
+        sums=stored("delay_fits", "SHA256SUMS"),
+    log:
+        stored("delay_fits", "log"),
+    benchmark:
+        stored("delay_fits", "benchmark.tsv")
+    priority: 1
+    conda:
+        ENV
+    script:
+        "../scripts/delay_fits.py"
+
+
+rule ssw:
+    input:
+        traces=trace_files,
+        pulses=made("pulses", "table"),
+        selection=selection_files,
+    output:
+        table=stored("ssw", "tables/ssw.csv"),
+        sums=stored("ssw", "SHA256SUMS"),
+    log:
+        stored("ssw", "log"),
+    benchmark:
+        stored("ssw", "benchmark.tsv")
+    params:
+        estimator=config["analysis"]["main_estimator"],
+    priority: 2
+    resources:
+        mem_mb=1000,  # MB
+        runtime=30,  # minutes
+    conda:
+        ENV
+    script:
+        "../scripts/ssw.py"
+
+
+rule ssw_fits:
+    input:
+        ssw=made("ssw", "table"),
+    output:
+        table=report(
+            stored("ssw_fits", "tables/ssw_fits.csv"),
+            caption="../report/ssw_fits.rst",
+            category="Tables",
+        ),
+        sums=stored("ssw_fits", "SHA256SUMS"),
+    log:
+        stored("ssw_fits", "log"),
+    benchmark:
+        stored("ssw_fits", "benchmark.tsv")
+    priority: 1
+    conda:
+        ENV
+    script:
+        "../scripts/ssw_fits.py"
+
+
+rule ssw_speed:
+    input:
+        tracks=lambda w: [
+            output_of("ssw_track", "track", model=m, N=n)
+            for m in PLAN.models
+            for n in PLAN.tracked_chains
+        ],
+    output:
+        track=stored("ssw_speed", "tables/ssw_track.csv"),
+        speed=stored("ssw_speed", "tables/ssw_speed.csv"),
+        sums=stored("ssw_speed", "SHA256SUMS"),
+    log:
+        stored("ssw_speed", "log"),
+    benchmark:
+        stored("ssw_speed", "benchmark.tsv")
+    params:
+        material=config["material"],
+        radius_m=config["radius_m"],
+    priority: 1
+    conda:
+        ENV
+    script:
+        "../scripts/ssw_speed.py"
+
+
+for table in ("pulses", "delays", "delay_fits", "ssw", "ssw_fits"):
+    publish(f"tables/{table}.csv", table, "table")
+publish("tables/ssw_track.csv", "ssw_speed", "track")
+publish("tables/ssw_speed.csv", "ssw_speed", "speed")
