@@ -33,6 +33,14 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
+
+
+# A stored job's folder ends in the key of its recipe (common.smk: stored()).
+wildcard_constraints:
+    key="[0-9a-f]{32}",
+    N=r"\d+",
+
+
 include: "workflow/rules/simulation.smk"
 include: "workflow/rules/experiment.smk"
 include: "workflow/rules/analysis.smk"

@@ -9,6 +9,8 @@ of F_m; and it is larger where the waves cross at a contact (even N) than at a b
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -64,6 +66,19 @@ def test_detached_ssw_runs_at_eq5_speed(long_even):
         # The SSW first stands out 4 beads past the collision contact, and detaches later.
         assert row.distance_beads == 4.0
         assert row.first_detached_contact is not None
+
+
+def test_the_shortest_long_chain_the_schema_allows_is_the_shortest_that_separates_an_ssw():
+    """long_chains.N starts at the shortest elastic chain whose SSW separates from the
+    main pulses (a run of linked maxima behind them): none at N = 25, at any speed (the
+    dynamics is self-similar in V0), one at N = 26 (even chains cross at a contact)."""
+    import yaml
+
+    schema_file = Path(__file__).resolve().parents[1] / "workflow/schemas/config.schema.yaml"
+    schema = yaml.safe_load(schema_file.read_text())
+    shortest = schema["properties"]["long_chains"]["properties"]["N"]["items"]["minimum"]
+    assert not track(shortest - 1)["separated"].any()
+    assert track(shortest)["separated"].any()
 
 
 def test_ssw_is_proportional_to_the_incident_amplitude():

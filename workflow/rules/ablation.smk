@@ -14,36 +14,38 @@ ABLATION = AblationPlan(PLAN)
 
 rule ablation_variant:
     input:
-        datasets=lambda w: virtual_datasets(w) if any(ABLATION.reads_run(w.variant)) else [],
+        datasets=lambda w: (
+            virtual_datasets(w) if any(ABLATION.reads_run(w.variant)) else []
+        ),
     output:
         fits=stored("ablation_variant", "ablation/{variant}_fits.csv", "{variant}"),
-        ssw_fits=stored("ablation_variant", "ablation/{variant}_ssw_fits.csv", "{variant}"),
+        ssw_fits=stored(
+            "ablation_variant", "ablation/{variant}_ssw_fits.csv", "{variant}"
+        ),
         sums=stored("ablation_variant", "SHA256SUMS", "{variant}"),
     log:
         stored("ablation_variant", "log", "{variant}"),
     benchmark:
         stored("ablation_variant", "benchmark.tsv", "{variant}")
+    priority: 1
+    conda:
+        ENV
     params:
         settings=lambda w: ABLATION.settings(w.variant),
         reads_run=lambda w: ABLATION.reads_run(w.variant),
         tolerance=lambda w: ABLATION.tolerance(w.variant),
         estimators=config["analysis"]["estimators"],
         series=PLAN.experiment.series,
-    priority: 1
-    conda:
-        ENV
     script:
         "../scripts/ablation_variant.py"
 
 
-def variant_fits(names, what="fits"):
-    """The fits of each variant of ``names`` (a twin's: its first's)."""
-    return [output_of("ablation_variant", what, variant=ABLATION.job(name)) for name in names]
-
-
 rule ablation_table:
     input:
-        fits=lambda w: variant_fits(ABLATION.names(full=w.which == "all")),
+        fits=lambda w: [
+            output_of("ablation_variant", "fits", variant=ABLATION.job(name))
+            for name in ABLATION.names(full=w.which == "all")
+        ],
     output:
         table=stored("ablation_table", "tables/ablation_exponent.csv", "{which}"),
         sums=stored("ablation_table", "SHA256SUMS", "{which}"),
@@ -51,12 +53,12 @@ rule ablation_table:
         stored("ablation_table", "log", "{which}"),
     benchmark:
         stored("ablation_table", "benchmark.tsv", "{which}")
+    conda:
+        ENV
     params:
         variants=lambda w: ABLATION.names(full=w.which == "all"),
         estimator=config["analysis"]["main_estimator"],
         overrides=ABLATION.overrides,
-    conda:
-        ENV
     script:
         "../scripts/ablation_table.py"
 

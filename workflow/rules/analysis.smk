@@ -3,14 +3,6 @@
 # contract tables. Well under a second per trace file: each table is one job.
 
 
-def trace_files(wildcards=None):
-    """Every trace file the analysis reads: the simulation's, then the experiment's."""
-    simulated = [
-        output_of("simulate", "traces", model=m, N=n) for m in PLAN.models for n in PLAN.chains
-    ]
-    return simulated + experiment_trace_files()
-
-
 rule pulses:
     input:
         traces=trace_files,
@@ -25,14 +17,14 @@ rule pulses:
         stored("pulses", "log"),
     benchmark:
         stored("pulses", "benchmark.tsv")
-    params:
-        estimators=config["analysis"]["estimators"],
     priority: 2
+    conda:
+        ENV
     resources:
         mem_mb=1000,  # MB (185 peak)
         runtime=30,  # minutes (~2 s per trace file)
-    conda:
-        ENV
+    params:
+        estimators=config["analysis"]["estimators"],
     script:
         "../scripts/pulses.py"
 
@@ -88,14 +80,14 @@ rule ssw:
         stored("ssw", "log"),
     benchmark:
         stored("ssw", "benchmark.tsv")
-    params:
-        estimator=config["analysis"]["main_estimator"],
     priority: 2
+    conda:
+        ENV
     resources:
         mem_mb=1000,  # MB
         runtime=30,  # minutes
-    conda:
-        ENV
+    params:
+        estimator=config["analysis"]["main_estimator"],
     script:
         "../scripts/ssw.py"
 
@@ -136,12 +128,12 @@ rule ssw_speed:
         stored("ssw_speed", "log"),
     benchmark:
         stored("ssw_speed", "benchmark.tsv")
-    params:
-        material=config["material"],
-        radius_m=config["radius_m"],
     priority: 1
     conda:
         ENV
+    params:
+        material=config["material"],
+        radius_m=config["radius_m"],
     script:
         "../scripts/ssw_speed.py"
 

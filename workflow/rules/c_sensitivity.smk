@@ -18,12 +18,12 @@ rule c_sensitivity:
         stored("c_sensitivity", "log"),
     benchmark:
         stored("c_sensitivity", "benchmark.tsv")
-    params:
-        plan=C_SENSITIVITY.every_estimator,
-        jobs=C_SENSITIVITY.jobs(),
     priority: 1
     conda:
         ENV
+    params:
+        plan=C_SENSITIVITY.every_estimator,
+        jobs=C_SENSITIVITY.jobs(),
     script:
         "../scripts/c_sensitivity.py"
 
@@ -38,11 +38,11 @@ rule c_sensitivity_table:
         stored("c_sensitivity_table", "log"),
     benchmark:
         stored("c_sensitivity_table", "benchmark.tsv")
+    conda:
+        ENV
     params:
         column="main_estimator",
         estimator=config["analysis"]["main_estimator"],
-    conda:
-        ENV
     script:
         "../scripts/main_estimator_rows.py"
 
@@ -54,7 +54,7 @@ rule fig_c_sensitivity:
         pdf=stored("fig_c_sensitivity", "figures/fig_c_sensitivity.pdf"),
         png=report(
             stored("fig_c_sensitivity", "figures/fig_c_sensitivity.png"),
-            caption=caption("fig_c_sensitivity"),
+            caption="../report/fig_c_sensitivity.rst",
             category="Figures",
         ),
         sums=stored("fig_c_sensitivity", "SHA256SUMS"),

@@ -1,4 +1,4 @@
-# Shared by the rule files: the config's check and plan, the result store, and how one
+# What every rule file shares. The config's check and plan, the result store, and how one
 # rule names another's outputs.
 #
 # Every computing rule writes into the result store (results/.store, or
@@ -50,11 +50,6 @@ if workflow.is_main_process:
         raise WorkflowError(str(error)) from None
 
 
-wildcard_constraints:
-    key="[0-9a-f]{32}",
-    N=r"\d+",
-
-
 def stored(rule, file, label=""):
     """Where the job of ``rule`` with the wildcards of ``label`` keeps ``file``: in its
     folder of the store, named by the rule, the label and its recipe's key."""
@@ -90,8 +85,8 @@ def key_of(rule, wildcards):
 #: The run folder (results/<run_name>): path in it -> (rule, output, wildcards) of the
 #: stored file it is a copy of, as each rule file lists them (publish()).
 RUN_FOLDER = {}
-#: summary.json's sections that the rule files add: name -> ("module:function" that
-#: summarises them, {table name: (rule, output, wildcards)}).
+#: summary.json's sections, as the rule files add them. Name -> (module and function that
+#: summarise them, "module:function"; {table name -> (rule, output, wildcards)}).
 SUMMARY_PARTS = {}
 
 
@@ -117,7 +112,32 @@ def run_folder_files():
     return [f"{OUT}/{path}" for path in RUN_FOLDER] + [f"{OUT}/SHA256SUMS"]
 
 
-def caption(name):
-    """A report caption: workflow/report/<name>.rst, or the generic figure caption."""
-    own = CHECKOUT / "workflow" / "report" / f"{name}.rst"
-    return f"../report/{name if own.exists() else 'figure'}.rst"
+# ---- inputs that several rule files read -------------------------------------------
+
+
+def trace_files(wildcards=None):
+    """Every trace file the analysis reads: the simulation's, then the experiment's."""
+    jobs = [{"model": m, "N": n} for m in PLAN.models for n in PLAN.chains]
+    return [
+        output_of("simulate", "traces", **job) for job in jobs
+    ] + experiment_trace_files()
+
+
+def experiment_trace_files(wildcards=None, shown=()):
+    """The experiment's trace files (of the chains ``shown``, or all)."""
+    return [
+        output_of("experiment_traces", name) for name in PLAN.experiment.shown(shown)
+    ]
+
+
+def virtual_datasets(wildcards=None):
+    """The virtual experiment's dataset folders, one per chain it runs."""
+    return [
+        output_of("virtual_experiment", "dataset", N=n)
+        for n in PLAN.experiment.virtual_n
+    ]
+
+
+def selection_files(wildcards=None):
+    """[experiment/selection.csv] when the run has an experiment, else []."""
+    return [output_of("selection", "table")] if PLAN.experiment.chains else []

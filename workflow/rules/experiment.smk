@@ -15,22 +15,17 @@ rule virtual_experiment:
         stored("virtual_experiment", "log", "N{N}"),
     benchmark:
         stored("virtual_experiment", "benchmark.tsv", "N{N}")
-    params:
-        settings=lambda w: PLAN.experiment.settings(int(w.N)),
-        dataset=PLAN.experiment.series,
     priority: 3
+    conda:
+        ENV
     resources:
         mem_mb=1000,  # MB (270 peak)
         runtime=30,  # minutes
-    conda:
-        ENV
+    params:
+        settings=lambda w: PLAN.experiment.settings(int(w.N)),
+        dataset=PLAN.experiment.series,
     script:
         "../scripts/virtual_experiment.py"
-
-
-def virtual_datasets(wildcards):
-    """The virtual experiment's dataset folders, one per chain it runs."""
-    return [output_of("virtual_experiment", "dataset", N=n) for n in PLAN.experiment.virtual_n]
 
 
 # One job loads every dataset: a job costs more start-up than a load.
@@ -48,18 +43,13 @@ rule experiment_traces:
         stored("experiment_traces", "log"),
     benchmark:
         stored("experiment_traces", "benchmark.tsv")
-    params:
-        **PLAN.experiment.loading,
     priority: 3
     conda:
         ENV
+    params:
+        **PLAN.experiment.loading,
     script:
         "../scripts/experiment_traces.py"
-
-
-def experiment_trace_files(wildcards=None, shown=()):
-    """The experiment's trace files (of the chains ``shown``, or all)."""
-    return [output_of("experiment_traces", name) for name in PLAN.experiment.shown(shown)]
 
 
 rule selection:
@@ -79,20 +69,15 @@ rule selection:
         stored("selection", "log"),
     benchmark:
         stored("selection", "benchmark.tsv")
-    params:
-        tolerance=config["experiment"]["tolerance"],
-        estimator=config["analysis"]["main_estimator"],
-        **PLAN.experiment.loading,
     priority: 2
     conda:
         ENV
+    params:
+        **PLAN.experiment.loading,
+        tolerance=config["experiment"]["tolerance"],
+        estimator=config["analysis"]["main_estimator"],
     script:
         "../scripts/selection.py"
-
-
-def selection_files(wildcards=None):
-    """[experiment/selection.csv] when the run has an experiment, else []."""
-    return [output_of("selection", "table")] if PLAN.experiment.chains else []
 
 
 if PLAN.experiment.chains:

@@ -9,7 +9,7 @@ rule fig1_setup:
         pdf=stored("fig1_setup", "figures/fig1_setup.pdf"),
         png=report(
             stored("fig1_setup", "figures/fig1_setup.png"),
-            caption=caption("fig1_setup"),
+            caption="../report/fig1_setup.rst",
             category="Figures",
         ),
         sums=stored("fig1_setup", "SHA256SUMS"),
@@ -17,20 +17,22 @@ rule fig1_setup:
         stored("fig1_setup", "log"),
     benchmark:
         stored("fig1_setup", "benchmark.tsv")
+    conda:
+        ENV
     params:
         chains=config["chains"],
         radius_m=config["radius_m"],
         material=config["material"],
         striker_radius_m=config["setup"]["striker_radius_m"],
-    conda:
-        ENV
     script:
         "../scripts/fig1_setup.py"
 
 
 rule fig2_experiment_traces:
     input:
-        traces=lambda w: experiment_trace_files(shown=config["figures"]["traces_N"] or ()),
+        traces=lambda w: experiment_trace_files(
+            shown=config["figures"]["traces_N"] or ()
+        ),
         pulses=made("pulses", "table"),
         ssw=made("ssw", "table"),
         selection=selection_files,
@@ -38,7 +40,7 @@ rule fig2_experiment_traces:
         pdf=stored("fig2_experiment_traces", "figures/fig2_experiment_traces.pdf"),
         png=report(
             stored("fig2_experiment_traces", "figures/fig2_experiment_traces.png"),
-            caption=caption("fig2_experiment_traces"),
+            caption="../report/fig2_experiment_traces.rst",
             category="Figures",
         ),
         sums=stored("fig2_experiment_traces", "SHA256SUMS"),
@@ -46,13 +48,13 @@ rule fig2_experiment_traces:
         stored("fig2_experiment_traces", "log"),
     benchmark:
         stored("fig2_experiment_traces", "benchmark.tsv")
+    conda:
+        ENV
     params:
         representative_force_N=config["figures"]["experiment_force_N"]
         or config["figures"]["representative_force_N"],
         estimator=config["analysis"]["main_estimator"],
         label=PLAN.experiment.label,
-    conda:
-        ENV
     script:
         "../scripts/fig2_experiment_traces.py"
 
@@ -60,7 +62,9 @@ rule fig2_experiment_traces:
 rule fig3_simulation_traces:
     input:
         traces=lambda w: [
-            output_of("simulate", "traces", model=config["figures"]["traces_model"], N=n)
+            output_of(
+                "simulate", "traces", model=config["figures"]["traces_model"], N=n
+            )
             for n in PLAN.traces_n
         ],
         pulses=made("pulses", "table"),
@@ -69,7 +73,7 @@ rule fig3_simulation_traces:
         pdf=stored("fig3_simulation_traces", "figures/fig3_simulation_traces.pdf"),
         png=report(
             stored("fig3_simulation_traces", "figures/fig3_simulation_traces.png"),
-            caption=caption("fig3_simulation_traces"),
+            caption="../report/fig3_simulation_traces.rst",
             category="Figures",
         ),
         sums=stored("fig3_simulation_traces", "SHA256SUMS"),
@@ -77,14 +81,14 @@ rule fig3_simulation_traces:
         stored("fig3_simulation_traces", "log"),
     benchmark:
         stored("fig3_simulation_traces", "benchmark.tsv")
+    conda:
+        ENV
     params:
         model=config["figures"]["traces_model"],
         representative_force_N=config["figures"]["representative_force_N"],
         representative_index=config["figures"]["representative_index"],
         estimator=config["analysis"]["main_estimator"],
         label="simulation",
-    conda:
-        ENV
     script:
         "../scripts/fig3_simulation_traces.py"
 
@@ -97,7 +101,7 @@ rule fig4_delay_vs_force:
         pdf=stored("fig4_delay_vs_force", "figures/fig4_delay_vs_force.pdf"),
         png=report(
             stored("fig4_delay_vs_force", "figures/fig4_delay_vs_force.png"),
-            caption=caption("fig4_delay_vs_force"),
+            caption="../report/fig4_delay_vs_force.rst",
             category="Figures",
         ),
         sums=stored("fig4_delay_vs_force", "SHA256SUMS"),
@@ -105,13 +109,13 @@ rule fig4_delay_vs_force:
         stored("fig4_delay_vs_force", "log"),
     benchmark:
         stored("fig4_delay_vs_force", "benchmark.tsv")
+    conda:
+        ENV
     params:
         material=config["material"],
         radius_m=config["radius_m"],
         estimator=config["analysis"]["main_estimator"],
         experiment_label=PLAN.experiment.label,
-    conda:
-        ENV
     script:
         "../scripts/fig4_delay_vs_force.py"
 
@@ -127,7 +131,7 @@ rule fig5_ssw_vs_force:
         pdf=stored("fig5_ssw_vs_force", "figures/fig5_ssw_vs_force.pdf"),
         png=report(
             stored("fig5_ssw_vs_force", "figures/fig5_ssw_vs_force.png"),
-            caption=caption("fig5_ssw_vs_force"),
+            caption="../report/fig5_ssw_vs_force.rst",
             category="Figures",
         ),
         sums=stored("fig5_ssw_vs_force", "SHA256SUMS"),
@@ -135,12 +139,12 @@ rule fig5_ssw_vs_force:
         stored("fig5_ssw_vs_force", "log"),
     benchmark:
         stored("fig5_ssw_vs_force", "benchmark.tsv")
-    params:
-        experiment_label=PLAN.experiment.label,
-        sensors={n: list(s) for n, s in PLAN.chains.items()},
     priority: 1
     conda:
         ENV
+    params:
+        experiment_label=PLAN.experiment.label,
+        sensors={n: list(s) for n, s in PLAN.chains.items()},
     script:
         "../scripts/fig5_ssw_vs_force.py"
 
@@ -150,13 +154,15 @@ rule fig5_ssw_vs_force:
 rule ssw_spacetime:
     input:
         fields=lambda w: [output_of("ssw_fields", f"N{n}") for n in PLAN.traces_n],
-        long_fields=lambda w: [output_of("ssw_fields", f"N{n}") for n in PLAN.long_chains],
+        long_fields=lambda w: [
+            output_of("ssw_fields", f"N{n}") for n in PLAN.long_chains
+        ],
         track=made("ssw_speed", "track"),
     output:
         pdf=stored("ssw_spacetime", "figures/ssw_spacetime.pdf"),
         png=report(
             stored("ssw_spacetime", "figures/ssw_spacetime.png"),
-            caption=caption("ssw_spacetime"),
+            caption="../report/ssw_spacetime.rst",
             category="Figures",
         ),
         sums=stored("ssw_spacetime", "SHA256SUMS"),
@@ -164,14 +170,14 @@ rule ssw_spacetime:
         stored("ssw_spacetime", "log"),
     benchmark:
         stored("ssw_spacetime", "benchmark.tsv")
+    priority: 1
+    conda:
+        ENV
+    threads: 2
     params:
         model=PLAN.simulation.spacetime_model,
         chains=list(PLAN.traces_n),
         long_chains=list(PLAN.long_chains),
-    priority: 1
-    threads: 2
-    conda:
-        ENV
     script:
         "../scripts/ssw_spacetime.py"
 
@@ -183,7 +189,7 @@ rule fig_parity_ssw_vs_N:
         pdf=stored("fig_parity_ssw_vs_N", "figures/fig_parity_ssw_vs_N.pdf"),
         png=report(
             stored("fig_parity_ssw_vs_N", "figures/fig_parity_ssw_vs_N.png"),
-            caption=caption("fig_parity_ssw_vs_N"),
+            caption="../report/fig_parity_ssw_vs_N.rst",
             category="Figures",
         ),
         sums=stored("fig_parity_ssw_vs_N", "SHA256SUMS"),
@@ -191,10 +197,10 @@ rule fig_parity_ssw_vs_N:
         stored("fig_parity_ssw_vs_N", "log"),
     benchmark:
         stored("fig_parity_ssw_vs_N", "benchmark.tsv")
-    params:
-        experiment_label=PLAN.experiment.label,
     conda:
         ENV
+    params:
+        experiment_label=PLAN.experiment.label,
     script:
         "../scripts/fig_parity_ssw_vs_N.py"
 

@@ -22,11 +22,11 @@ rule lammps_check:
         stored("lammps_check", "log"),
     benchmark:
         stored("lammps_check", "benchmark.tsv")
+    conda:
+        ENV
     params:
         config=MECHANISMS.lammps_config,
         estimators=config["analysis"]["estimators"],
-    conda:
-        ENV
     script:
         "../scripts/lammps_check.py"
 
@@ -41,61 +41,74 @@ rule lammps_check_table:
         stored("lammps_check_table", "log"),
     benchmark:
         stored("lammps_check_table", "benchmark.tsv")
+    conda:
+        ENV
     params:
         column="estimator",
         estimator=config["analysis"]["main_estimator"],
-    conda:
-        ENV
     script:
         "../scripts/main_estimator_rows.py"
 
 
 rule lammps_setting:
     output:
-        traces=stored("lammps_setting", "lammps/{setting}_N{N}_traces.csv", "{setting}_N{N}"),
-        runs=stored("lammps_setting", "lammps/{setting}_N{N}_runs.csv", "{setting}_N{N}"),
+        traces=stored(
+            "lammps_setting", "lammps/{setting}_N{N}_traces.csv", "{setting}_N{N}"
+        ),
+        runs=stored(
+            "lammps_setting", "lammps/{setting}_N{N}_runs.csv", "{setting}_N{N}"
+        ),
         delay_fits=stored(
             "lammps_setting", "lammps/{setting}_N{N}_delay_fits.csv", "{setting}_N{N}"
         ),
-        ssw_fits=stored("lammps_setting", "lammps/{setting}_N{N}_ssw_fits.csv", "{setting}_N{N}"),
+        ssw_fits=stored(
+            "lammps_setting", "lammps/{setting}_N{N}_ssw_fits.csv", "{setting}_N{N}"
+        ),
         sums=stored("lammps_setting", "SHA256SUMS", "{setting}_N{N}"),
     log:
         stored("lammps_setting", "log", "{setting}_N{N}"),
     benchmark:
         stored("lammps_setting", "benchmark.tsv", "{setting}_N{N}")
+    conda:
+        ENV
     params:
         config=MECHANISMS.lammps_config,
         estimators=config["analysis"]["estimators"],
         sensors=lambda w: list(PLAN.chains[int(w.N)]),
-    conda:
-        ENV
     script:
         "../scripts/lammps_setting.py"
 
 
-def setting_fits(group, what):
-    """An input function: the fits ``what`` of each setting of ``group`` (lammps or
-    viscous) of tables/ssw_mechanisms{,_all}.csv, every chain."""
-    return lambda w: [
-        output_of("lammps_setting", what, setting=setting, N=n)
-        for setting in MECHANISMS.settings(group, full=w.which == "all")
-        for n in PLAN.chains
-    ]
-
-
-def candidate_fits(what):
-    """An input function: the fits ``what`` of each candidate variant."""
-    return lambda w: variant_fits(MECHANISMS.candidates(full=w.which == "all"), what)
-
-
 rule ssw_mechanisms:
     input:
-        lammps_delay_fits=setting_fits("lammps", "delay_fits"),
-        lammps_ssw_fits=setting_fits("lammps", "ssw_fits"),
-        viscous_delay_fits=setting_fits("viscous", "delay_fits"),
-        viscous_ssw_fits=setting_fits("viscous", "ssw_fits"),
-        candidate_fits=candidate_fits("fits"),
-        candidate_ssw_fits=candidate_fits("ssw_fits"),
+        lammps_delay_fits=lambda w: [
+            output_of("lammps_setting", "delay_fits", setting=setting, N=n)
+            for setting in MECHANISMS.settings("lammps", full=w.which == "all")
+            for n in PLAN.chains
+        ],
+        lammps_ssw_fits=lambda w: [
+            output_of("lammps_setting", "ssw_fits", setting=setting, N=n)
+            for setting in MECHANISMS.settings("lammps", full=w.which == "all")
+            for n in PLAN.chains
+        ],
+        viscous_delay_fits=lambda w: [
+            output_of("lammps_setting", "delay_fits", setting=setting, N=n)
+            for setting in MECHANISMS.settings("viscous", full=w.which == "all")
+            for n in PLAN.chains
+        ],
+        viscous_ssw_fits=lambda w: [
+            output_of("lammps_setting", "ssw_fits", setting=setting, N=n)
+            for setting in MECHANISMS.settings("viscous", full=w.which == "all")
+            for n in PLAN.chains
+        ],
+        candidate_fits=lambda w: [
+            output_of("ablation_variant", "fits", variant=ABLATION.job(name))
+            for name in MECHANISMS.candidates(full=w.which == "all")
+        ],
+        candidate_ssw_fits=lambda w: [
+            output_of("ablation_variant", "ssw_fits", variant=ABLATION.job(name))
+            for name in MECHANISMS.candidates(full=w.which == "all")
+        ],
     output:
         table=stored("ssw_mechanisms", "tables/ssw_mechanisms.csv", "{which}"),
         sums=stored("ssw_mechanisms", "SHA256SUMS", "{which}"),
@@ -103,12 +116,12 @@ rule ssw_mechanisms:
         stored("ssw_mechanisms", "log", "{which}"),
     benchmark:
         stored("ssw_mechanisms", "benchmark.tsv", "{which}")
+    conda:
+        ENV
     params:
         **MECHANISMS.table_params,
         candidates=lambda w: MECHANISMS.candidates(full=w.which == "all"),
         estimator=config["analysis"]["main_estimator"],
-    conda:
-        ENV
     script:
         "../scripts/ssw_mechanisms.py"
 
@@ -120,7 +133,7 @@ rule fig_ssw_mechanisms:
         pdf=stored("fig_ssw_mechanisms", "figures/fig_ssw_mechanisms.pdf"),
         png=report(
             stored("fig_ssw_mechanisms", "figures/fig_ssw_mechanisms.png"),
-            caption=caption("fig_ssw_mechanisms"),
+            caption="../report/fig_ssw_mechanisms.rst",
             category="Figures",
         ),
         sums=stored("fig_ssw_mechanisms", "SHA256SUMS"),
@@ -141,6 +154,8 @@ if MECHANISMS.lammps:
 if MECHANISMS.table_made:
     publish("tables/ssw_mechanisms.csv", "ssw_mechanisms", "table", which="default")
     publish_figure("fig_ssw_mechanisms")
-    summarise("ssw_mechanisms", "chain.report.numbers.mechanisms:mechanism_summary", **tables)
+    summarise(
+        "ssw_mechanisms", "chain.report.numbers.mechanisms:mechanism_summary", **tables
+    )
 if MECHANISMS.full:
     publish("tables/ssw_mechanisms_all.csv", "ssw_mechanisms", "table", which="all")

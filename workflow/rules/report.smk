@@ -6,17 +6,13 @@
 # them, and their SHA256SUMS. Included last: it gathers what the other files publish.
 
 
-def summary_part_inputs():
-    """The tables of the sections the studies add (summarise()), as named inputs."""
-    return {
-        f"{part}__{name}": made(rule, output, **wildcards)
-        for part, (_, tables) in SUMMARY_PARTS.items()
-        for name, (rule, output, wildcards) in tables.items()
-    }
-
-
 rule summary:
     input:
+        **{
+            f"{part}__{name}": made(rule, output, **wildcards)
+            for part, (_, tables) in SUMMARY_PARTS.items()
+            for name, (rule, output, wildcards) in tables.items()
+        },
         delay_fits=made("delay_fits", "table"),
         ssw_fits=made("ssw_fits", "table"),
         pulses=made("pulses", "table"),
@@ -25,9 +21,10 @@ rule summary:
         ssw_speed=made("ssw_speed", "speed"),
         selection=selection_files,
         runs=lambda w: [
-            output_of("simulate", "runs", model=m, N=n) for m in PLAN.models for n in PLAN.chains
+            output_of("simulate", "runs", model=m, N=n)
+            for m in PLAN.models
+            for n in PLAN.chains
         ],
-        **summary_part_inputs(),
     output:
         json=stored("summary", "summary.json"),
         sums=stored("summary", "SHA256SUMS"),
@@ -35,6 +32,8 @@ rule summary:
         stored("summary", "log"),
     benchmark:
         stored("summary", "benchmark.tsv")
+    conda:
+        ENV
     params:
         run_name=PLAN.run_name,
         material=config["material"],
@@ -43,13 +42,14 @@ rule summary:
         estimator=config["analysis"]["main_estimator"],
         experiment_label=PLAN.experiment.label,
         tolerance=config["experiment"]["tolerance"],
-        parts={part: [function, list(tables)] for part, (function, tables) in SUMMARY_PARTS.items()},
+        parts={
+            part: [function, list(tables)]
+            for part, (function, tables) in SUMMARY_PARTS.items()
+        },
         # The studies switched off (summary.md and the article say they did not run).
         studies_not_run=PLAN.studies_not_run,
         # Commit, config hash, installed versions and how they compare with the lock.
         provenance=PLAN.provenance,
-    conda:
-        ENV
     script:
         "../scripts/summary.py"
 
@@ -92,12 +92,12 @@ rule article:
         stored("article", "log"),
     benchmark:
         stored("article", "benchmark.tsv")
+    conda:
+        ENV
     params:
         setup=PLAN.article_setup,
         # A changed commit or configuration rebuilds the article, which states them.
         provenance=PLAN.provenance,
-    conda:
-        ENV
     script:
         "../scripts/article.py"
 
@@ -116,7 +116,9 @@ for path, rule, name in [
 # batch job.
 rule run_folder:
     input:
-        lambda w: [output_of(rule, name, **wc) for rule, name, wc in RUN_FOLDER.values()],
+        lambda w: [
+            output_of(rule, name, **wc) for rule, name, wc in RUN_FOLDER.values()
+        ],
     output:
         [f"{OUT}/{path}" for path in RUN_FOLDER],
         sums=f"{OUT}/SHA256SUMS",

@@ -14,17 +14,17 @@ rule simulate:
         stored("simulate", "log", "{model}_N{N}"),
     benchmark:
         stored("simulate", "benchmark.tsv", "{model}_N{N}")
-    params:
-        job=lambda w: PLAN.simulate_job(w.model, int(w.N)),
     # First: the pulse table waits for them; the first chain of each model ahead of the
     # others, so that the kernels compile side by side on a fresh clone.
     priority: lambda w: 4 if int(w.N) == next(iter(PLAN.chains)) else 3
+    conda:
+        ENV
     threads: lambda w: PLAN.simulation.threads(w)
     resources:
         mem_mb=PLAN.simulation.mem_mb,
         runtime=PLAN.simulation.runtime,
-    conda:
-        ENV
+    params:
+        job=lambda w: PLAN.simulate_job(w.model, int(w.N)),
     script:
         "../scripts/simulate.py"
 
@@ -32,21 +32,23 @@ rule simulate:
 # Half a simulate job's work: its requests are an upper bound.
 rule ssw_track:
     output:
-        track=stored("ssw_track", "simulation/{model}_N{N}_ssw_track.csv", "{model}_N{N}"),
+        track=stored(
+            "ssw_track", "simulation/{model}_N{N}_ssw_track.csv", "{model}_N{N}"
+        ),
         sums=stored("ssw_track", "SHA256SUMS", "{model}_N{N}"),
     log:
         stored("ssw_track", "log", "{model}_N{N}"),
     benchmark:
         stored("ssw_track", "benchmark.tsv", "{model}_N{N}")
-    params:
-        job=lambda w: PLAN.simulate_job(w.model, int(w.N)),
     priority: 3
+    conda:
+        ENV
     threads: lambda w: PLAN.simulation.threads(w)
     resources:
         mem_mb=PLAN.simulation.mem_mb,
         runtime=PLAN.simulation.runtime,
-    conda:
-        ENV
+    params:
+        job=lambda w: PLAN.simulate_job(w.model, int(w.N)),
     script:
         "../scripts/ssw_track.py"
 
@@ -70,6 +72,9 @@ rule ssw_fields:
         stored("ssw_fields", "log"),
     benchmark:
         stored("ssw_fields", "benchmark.tsv")
+    priority: 3
+    conda:
+        ENV
     params:
         jobs=lambda w: [
             PLAN.simulate_job(PLAN.simulation.spacetime_model, n)
@@ -77,8 +82,5 @@ rule ssw_fields:
         ],
         representative_force_N=config["figures"]["representative_force_N"],
         representative_index=config["figures"]["representative_index"],
-    priority: 3
-    conda:
-        ENV
     script:
         "../scripts/ssw_fields.py"

@@ -19,11 +19,11 @@ rule sweep_table:
         stored("sweep_table", "log"),
     benchmark:
         stored("sweep_table", "benchmark.tsv")
+    conda:
+        ENV
     params:
         eta_s=PLAN.models,
         estimator=config["analysis"]["main_estimator"],
-    conda:
-        ENV
     script:
         "../scripts/sweep_table.py"
 
@@ -35,7 +35,7 @@ rule fig_c_vs_N:
         pdf=stored("fig_c_vs_N", "figures/fig_c_vs_N.pdf"),
         png=report(
             stored("fig_c_vs_N", "figures/fig_c_vs_N.png"),
-            caption=caption("fig_c_vs_N"),
+            caption="../report/fig_c_vs_N.rst",
             category="Figures",
         ),
         sums=stored("fig_c_vs_N", "SHA256SUMS"),

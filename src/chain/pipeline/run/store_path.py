@@ -142,7 +142,7 @@ def open_store_folder(root: Path, create: bool, mode: int, group: int | None) ->
         if isinstance(error, OSError):
             raise StoreError(
                 f"result store {root}: {error.strerror} ({here}); set {STORE_VARIABLE} to a "
-                "folder you can write, or run with --config reuse=False"
+                "folder you can write"
             ) from None
         raise
 
