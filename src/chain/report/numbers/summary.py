@@ -73,6 +73,20 @@ def _records(table: pd.DataFrame | None) -> list[dict]:
     return records
 
 
+def table_section(tables: Mapping[str, pd.DataFrame], run: Mapping) -> dict:
+    """A study's section of summary.json that is its tables' rows: name -> records (for
+    a study without a verdict of its own; ``run``, the run's tables, unused).
+
+    Parameters
+    ----------
+    tables : mapping
+        Table name -> the study's table.
+    run : mapping
+        The run's own tables and main estimator.
+    """
+    return {name: _records(table) for name, table in tables.items()}
+
+
 def build_summary(
     *,
     run_name: str,
