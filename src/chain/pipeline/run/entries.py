@@ -104,7 +104,11 @@ def verify_inputs(paths: Iterable[str]) -> dict[str, str]:
         if entry is None or not (entry / SUMS).is_file():
             continue
         listed = read_sums(entry)
-        for file in stored_files(os.path.abspath(path)):
+        files = stored_files(os.path.abspath(path))
+        if os.path.isdir(path):  # and those listed in the folder that are gone
+            folder = Path(os.path.abspath(path)).relative_to(entry).as_posix()
+            files += sorted({entry / n for n in listed if n.startswith(f"{folder}/")} - set(files))
+        for file in files:
             name = file.relative_to(entry).as_posix()
             got = file_digest(file) if file.is_file() and not file.is_symlink() else "missing"
             if listed.get(name) != got:
@@ -140,7 +144,7 @@ def seal(outputs: Iterable[str], sums: str, inputs: dict[str, str]) -> None:
     for file in files:
         os.chmod(file, 0o440 if group else stat.S_IMODE(os.stat(file).st_mode) & ~0o222)
     if group:
-        for folder in {entry, *(f.parent for f in files)}:
+        for folder in {entry, *(entry / p for f in files for p in f.relative_to(entry).parents)}:
             os.chmod(folder, 0o2770)
     write_text_atomic("".join(lines), sums)
     os.chmod(sums, 0o440 if group else stat.S_IMODE(os.stat(sums).st_mode) & ~0o222)
