@@ -21,6 +21,7 @@ from chain.pipeline.run.checksums import run_files
 from chain.pipeline.run.entries import (
     CHUNK,
     ENTRY,
+    SUMS,
     DamagedEntry,
     discard,
     entry_of,
@@ -70,7 +71,7 @@ def upstream(entries: set[Path]) -> list[Path]:
     found, todo = set(), list(entries)
     while todo:
         entry = todo.pop()
-        if entry in found:
+        if entry in found or not (entry / SUMS).is_file():  # gone: pruned, or discarded
             continue
         found.add(entry)
         inputs = [name for name in read_sums(entry) if name.startswith("../")]

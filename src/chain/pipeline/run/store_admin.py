@@ -22,7 +22,7 @@ from chain.pipeline.run.publish import upstream
 def entries(store: str | Path) -> list[tuple[Path, int]]:
     """(folder, size in bytes) of each sealed entry of the store, sorted."""
     found = []
-    root = Path(store)
+    root = Path(os.path.abspath(store))  # as entry_of and upstream name them
     for entry in sorted(root.iterdir()) if root.is_dir() else []:
         if ENTRY.match(entry.name) and (entry / SUMS).is_file():
             size = sum(p.lstat().st_size for p in entry.rglob("*") if p.is_file())
