@@ -16,7 +16,6 @@ from chain.report.figures.fig_c_sensitivity import fig_c_sensitivity
 from chain.report.numbers.spread import ablation_summary, c_spread_summary
 from chain.report.text.markdown_studies import spread_markdown_rows
 from chain.studies.c_sensitivity import (
-    c_sensitivity_every_estimator,
     c_sensitivity_table,
     sensitivity_plan,
     shifted_pairs,
@@ -69,26 +68,18 @@ def small_table(small_study):
     return c_sensitivity_table(*small_study)
 
 
-def test_the_main_estimators_table_is_picked_with_the_same_bytes(small_study, tmp_path):
-    """The study's job writes the table for every estimator as the headline one; the
-    reported table, picked from that file for the main estimator (rule
-    c_sensitivity_table), has the bytes of the table computed for it alone."""
-    from chain.analysis.rows import picked
-    from chain.atomic import write_csv_atomic
+def test_recorded_readings_give_the_shots_the_study_would_simulate_bit_for_bit(tmp_path):
+    """A simulate job records every bead's felt force (its readings); the study reads its
+    shifted sensors there instead of integrating the same launches again: the trace
+    table is the one simulated for those beads alone, bit for bit (recording every
+    contact does not change the integration)."""
+    from chain.apparatus.shots import readings_table, save_readings, simulate_launches
 
-    traces, plan = small_study
-    study = {k: v for k, v in plan.items() if k != "main_estimator"}
-    every = tmp_path / "every_estimator.csv"
-    write_csv_atomic(c_sensitivity_every_estimator(traces, study), every)
-    headlines = []
-    for estimator in plan["estimators"]:
-        alone = c_sensitivity_table(traces, {**plan, "main_estimator": estimator})
-        write_csv_atomic(alone, tmp_path / "alone.csv")
-        table = picked(pd.read_csv(every), "main_estimator", estimator)
-        write_csv_atomic(table, tmp_path / "picked.csv")
-        assert (tmp_path / "picked.csv").read_bytes() == (tmp_path / "alone.csv").read_bytes()
-        headlines.append(alone.loc[alone["headline"], "estimator"].unique().tolist())
-    assert headlines == [[e] for e in plan["estimators"]]
+    model, speeds, beads = uniform_chain(16, eta=0.58e-6), [0.05, 0.2], [4, 6, 11, 13]
+    alone, _ = simulate_shots(model, speeds, beads, model_name="m", duration=1.4e-3)
+    save_readings(simulate_launches(model, speeds, duration=1.4e-3), tmp_path / "r.npz")
+    read = readings_table(tmp_path / "r.npz", beads, model_name="m")
+    pd.testing.assert_frame_equal(read, alone, check_exact=True)
 
 
 def test_elastic_row_has_the_hertz_exponent(small_table):
@@ -137,7 +128,8 @@ def test_ablation_verdict_names_the_numbers():
         }
     )
     # Printed with the minus sign U+2212 (chain.report.printed); compared as ASCII.
-    verdict = ablation_summary({"table": ablation}, {"delay_fits": fits, "estimator": "fit_full"})["verdict"].replace("\u2212", "-")
+    run = {"delay_fits": fits, "estimator": "fit_full"}
+    verdict = ablation_summary({"table": ablation}, run)["verdict"].replace("\u2212", "-")
     for number in ("-0.214", "-0.169", "-0.154", "viscoelastic -0.152"):
         assert number in verdict
     missing = ablation_summary(

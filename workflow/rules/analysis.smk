@@ -116,7 +116,9 @@ rule ssw_fits:
 rule ssw_speed:
     input:
         tracks=lambda w: [
-            output_of("ssw_track", "track", model=m, N=n)
+            output_of(
+                "simulate" if n in PLAN.chains else "long_chain", "track", model=m, N=n
+            )
             for m in PLAN.models
             for n in PLAN.tracked_chains
         ],

@@ -1,18 +1,38 @@
 # The C-sensitivity study: how much C depends on our choices (estimator, eta, sensor
-# pair, amplitude range, one at a time from the headline choice), on shots simulated
-# anew with every sensor bead of every pair recorded (chain.studies.c_sensitivity). One
-# job computes the table for every estimator as the headline one (the simulations are
-# the cost), so that a what-if choosing another main estimator reuses it;
-# c_sensitivity_table picks the main one.
+# pair, amplitude range, one at a time from the headline choice, the run's main
+# estimator), on simulated shots read at every bead of every sensor pair
+# (chain.studies.c_sensitivity): those of a configured model's eta as its simulate job
+# recorded them, the others simulated by c_sensitivity_simulate.
 
 from chain.pipeline.plan.c_sensitivity import CSensitivityPlan
 
 C_SENSITIVITY = CSensitivityPlan(PLAN)
 
 
-rule c_sensitivity:
+rule c_sensitivity_simulate:
     output:
-        table=stored("c_sensitivity", "c_sensitivity/every_estimator.csv"),
+        readings=stored("c_sensitivity_simulate", "readings.npz", "eta{eta}_N{N}"),
+        sums=stored("c_sensitivity_simulate", "SHA256SUMS", "eta{eta}_N{N}"),
+    log:
+        stored("c_sensitivity_simulate", "log", "eta{eta}_N{N}"),
+    benchmark:
+        stored("c_sensitivity_simulate", "benchmark.tsv", "eta{eta}_N{N}")
+    priority: 2
+    conda:
+        ENV
+    params:
+        job=lambda w: C_SENSITIVITY.job(w.eta, w.N),
+    script:
+        "../scripts/c_sensitivity_simulate.py"
+
+
+rule c_sensitivity:
+    input:
+        readings=lambda w: [
+            output_of(r, o, **wc) for r, o, wc in C_SENSITIVITY.readings()
+        ],
+    output:
+        table=stored("c_sensitivity", "tables/c_sensitivity.csv"),
         sums=stored("c_sensitivity", "SHA256SUMS"),
     log:
         stored("c_sensitivity", "log"),
@@ -22,34 +42,15 @@ rule c_sensitivity:
     conda:
         ENV
     params:
-        plan=C_SENSITIVITY.every_estimator,
+        plan=C_SENSITIVITY.choices,
         jobs=C_SENSITIVITY.jobs(),
     script:
         "../scripts/c_sensitivity.py"
 
 
-rule c_sensitivity_table:
-    input:
-        table=made("c_sensitivity", "table"),
-    output:
-        table=stored("c_sensitivity_table", "tables/c_sensitivity.csv"),
-        sums=stored("c_sensitivity_table", "SHA256SUMS"),
-    log:
-        stored("c_sensitivity_table", "log"),
-    benchmark:
-        stored("c_sensitivity_table", "benchmark.tsv")
-    conda:
-        ENV
-    params:
-        column="main_estimator",
-        estimator=config["analysis"]["main_estimator"],
-    script:
-        "../scripts/main_estimator_rows.py"
-
-
 rule fig_c_sensitivity:
     input:
-        table=made("c_sensitivity_table", "table"),
+        table=made("c_sensitivity", "table"),
     output:
         pdf=stored("fig_c_sensitivity", "figures/fig_c_sensitivity.pdf"),
         png=report(
@@ -69,10 +70,10 @@ rule fig_c_sensitivity:
 
 
 if PLAN.study("c_sensitivity"):
-    publish("tables/c_sensitivity.csv", "c_sensitivity_table", "table")
+    publish("tables/c_sensitivity.csv", "c_sensitivity", "table")
     publish_figure("fig_c_sensitivity")
     summarise(
         "c_spread",
         "chain.report.numbers.spread:c_spread_summary",
-        table=("c_sensitivity_table", "table", {}),
+        table=("c_sensitivity", "table", {}),
     )

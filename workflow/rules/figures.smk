@@ -153,9 +153,15 @@ rule fig5_ssw_vs_force:
 # once, in two processes on a cluster (a local run gives it one core: profiles/default).
 rule ssw_spacetime:
     input:
-        fields=lambda w: [output_of("ssw_fields", f"N{n}") for n in PLAN.traces_n],
+        fields=lambda w: [
+            output_of("simulate", "field", model=PLAN.simulation.spacetime_model, N=n)
+            for n in PLAN.traces_n
+        ],
         long_fields=lambda w: [
-            output_of("ssw_fields", f"N{n}") for n in PLAN.long_chains
+            output_of(
+                "long_chain", "field", model=PLAN.simulation.spacetime_model, N=n
+            )
+            for n in PLAN.long_chains
         ],
         track=made("ssw_speed", "track"),
     output:
@@ -178,6 +184,8 @@ rule ssw_spacetime:
         model=PLAN.simulation.spacetime_model,
         chains=list(PLAN.traces_n),
         long_chains=list(PLAN.long_chains),
+        representative_force_N=config["figures"]["representative_force_N"],
+        representative_index=config["figures"]["representative_index"],
     script:
         "../scripts/ssw_spacetime.py"
 

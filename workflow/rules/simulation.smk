@@ -1,14 +1,22 @@
 # The simulation: one job per model and chain integrates the collision and reference
-# shots of every launch speed and records the sensor beads (simulate); each chain's
-# collisions again with every contact recorded, the SSW tracked contact by contact, the
-# long chains of long_chains too (ssw_track); the collision the space-time figure shows,
-# every contact recorded (ssw_fields).
+# shots of every launch speed once, every contact recorded, and writes what the rest
+# of the run reads of them: the sensor traces, the runs, the SSW tracked contact by
+# contact, the collisions' field pooled for the space-time figure, and every bead's
+# felt force (simulate); the collisions of the long chains of long_chains, tracked
+# (long_chain).
 
 
 rule simulate:
     output:
         traces=stored("simulate", "simulation/{model}_N{N}_traces.csv", "{model}_N{N}"),
         runs=stored("simulate", "simulation/{model}_N{N}_runs.csv", "{model}_N{N}"),
+        track=stored(
+            "simulate", "simulation/{model}_N{N}_ssw_track.csv", "{model}_N{N}"
+        ),
+        field=stored("simulate", "simulation/{model}_N{N}_field.npz", "{model}_N{N}"),
+        readings=stored(
+            "simulate", "simulation/{model}_N{N}_readings.npz", "{model}_N{N}"
+        ),
         sums=stored("simulate", "SHA256SUMS", "{model}_N{N}"),
     log:
         stored("simulate", "log", "{model}_N{N}"),
@@ -29,17 +37,17 @@ rule simulate:
         "../scripts/simulate.py"
 
 
-# Half a simulate job's work: its requests are an upper bound.
-rule ssw_track:
+rule long_chain:
     output:
         track=stored(
-            "ssw_track", "simulation/{model}_N{N}_ssw_track.csv", "{model}_N{N}"
+            "long_chain", "simulation/{model}_N{N}_ssw_track.csv", "{model}_N{N}"
         ),
-        sums=stored("ssw_track", "SHA256SUMS", "{model}_N{N}"),
+        field=stored("long_chain", "simulation/{model}_N{N}_field.npz", "{model}_N{N}"),
+        sums=stored("long_chain", "SHA256SUMS", "{model}_N{N}"),
     log:
-        stored("ssw_track", "log", "{model}_N{N}"),
+        stored("long_chain", "log", "{model}_N{N}"),
     benchmark:
-        stored("ssw_track", "benchmark.tsv", "{model}_N{N}")
+        stored("long_chain", "benchmark.tsv", "{model}_N{N}")
     priority: 3
     conda:
         ENV
@@ -50,37 +58,4 @@ rule ssw_track:
     params:
         job=lambda w: PLAN.simulate_job(w.model, int(w.N)),
     script:
-        "../scripts/ssw_track.py"
-
-
-# The one collision per chain that the space-time figure shows, integrated again at
-# ssw_track's step (the same numbers bit for bit).
-rule ssw_fields:
-    input:
-        tracks=lambda w: [
-            output_of("ssw_track", "track", model=PLAN.simulation.spacetime_model, N=n)
-            for n in PLAN.simulation.field_chains
-        ],
-    output:
-        **{
-            f"N{n}": stored("ssw_fields", f"simulation/{model}_N{n}_field.csv")
-            for model in [PLAN.simulation.spacetime_model]
-            for n in PLAN.simulation.field_chains
-        },
-        sums=stored("ssw_fields", "SHA256SUMS"),
-    log:
-        stored("ssw_fields", "log"),
-    benchmark:
-        stored("ssw_fields", "benchmark.tsv")
-    priority: 3
-    conda:
-        ENV
-    params:
-        jobs=lambda w: [
-            PLAN.simulate_job(PLAN.simulation.spacetime_model, n)
-            for n in PLAN.simulation.field_chains
-        ],
-        representative_force_N=config["figures"]["representative_force_N"],
-        representative_index=config["figures"]["representative_index"],
-    script:
-        "../scripts/ssw_fields.py"
+        "../scripts/long_chain.py"

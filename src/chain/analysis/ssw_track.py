@@ -41,10 +41,13 @@ it as a function: it knows no material). In a 120-bead chain the fitted speed is
 from __future__ import annotations
 
 import math
+import os
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
+from chain.atomic import atomic_output
 from chain.errors import ParameterError
 
 #: Least SSW height and prominence, as a fraction of the incident amplitude F_m.
@@ -333,23 +336,48 @@ def representative_shot(track: pd.DataFrame, force_N: float, index: int | None =
     return int(shots.loc[(shots["F_m_N"] - force_N).abs().idxmin(), "shot"])
 
 
-def field_table(time_s, contact_force_N, *, shot: int) -> pd.DataFrame:
-    """Contact forces of one collision over time, for the space-time figure.
+#: Time bins of a pooled field (:func:`pooled_field`): at least the space-time figure's
+#: panel width in pixels, which then draws each bin as one column.
+FIELD_BINS = 1000
+
+
+@dataclass(frozen=True)
+class Field:
+    """The contact forces of a batch of collisions, pooled in time: ``force_N[shot,
+    contact - 1, bin]`` is the largest force of that contact in the bin, N (float32:
+    a picture's precision); ``time_us`` the bins' centres, us."""
+
+    time_us: np.ndarray
+    force_N: np.ndarray
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write the field as ``.npz`` (no pickle), atomically."""
+        with atomic_output(path) as temporary, open(temporary, "wb") as stream:
+            np.savez(stream, time_us=self.time_us, force_N=self.force_N)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Field:
+        """Read a field :meth:`save` wrote."""
+        with np.load(path, allow_pickle=False) as arrays:
+            return cls(arrays["time_us"], arrays["force_N"])
+
+
+def pooled_field(time_s, contact_force_N, bins: int = FIELD_BINS) -> Field:
+    """The field of a batch of collisions in ``bins`` time bins (fewer if there are
+    fewer samples), each the largest force of its samples: what a picture of the field
+    shows at its pixels' width, a 1 % SSW peak included.
 
     Parameters
     ----------
     time_s : (S,) array
         Sample times, s.
-    contact_force_N : (S, N-1) array
-        Forces at contacts 1..N-1, N.
-    shot : int
-        Shot id written in the ``shot`` column.
-
-    Returns
-    -------
-    DataFrame
-        ``shot, t_us, contact_1 .. contact_<N-1>`` (N).
+    contact_force_N : (B, S, N-1) array
+        Forces at contacts 1..N-1 of each collision, N.
+    bins : int
+        Time bins.
     """
-    force = np.asarray(contact_force_N, dtype=float)
-    columns = {f"contact_{k}": force[:, k - 1] for k in range(1, force.shape[1] + 1)}
-    return pd.DataFrame({"shot": shot, "t_us": np.asarray(time_s) * 1e6, **columns})
+    time = np.asarray(time_s, dtype=float)
+    edges = np.linspace(0, time.size, min(bins, time.size) + 1).astype(int)
+    force = np.maximum.reduceat(np.asarray(contact_force_N), edges[:-1], axis=1)
+    centres = 0.5 * (time[edges[:-1]] + time[edges[1:] - 1]) * 1e6
+    return Field(centres, np.ascontiguousarray(force.transpose(0, 2, 1), dtype=np.float32))

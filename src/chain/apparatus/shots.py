@@ -8,10 +8,12 @@ out at the sensor beads into the project's one trace format (:mod:`chain.traces`
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 
+from chain.atomic import atomic_output
 from chain.errors import ParameterError
 from chain.physics.integrator import DEFAULT_MAX_ENERGY_DRIFT
 from chain.physics.model import ChainModel
@@ -57,20 +59,30 @@ def trace_table(
     if readout not in ("felt", "sensor"):
         raise ParameterError(f"readout must be 'felt' or 'sensor', got {readout!r}")
     read = result.force_felt if readout == "felt" else result.sensor
-    columns = {sensor_column(b): read(b) for b in beads}
-    batch, samples = result.contact_force.shape[:2]
+    forces = {b: read(b) for b in beads}
+    launches = (result.time, result.v_left, result.v_right)
+    return launch_table(launches, forces, result.model.n_beads, kind, model_name, first_shot)
+
+
+def launch_table(launches, forces, n_beads: int, kind: str, model_name: str, first_shot: int):
+    """A trace table (source ``simulation``) of B launches: ``launches`` = (time (S,) s,
+    left and right launch speeds (B,) m/s), ``forces`` = bead -> (B, S) force, N; the
+    other arguments as :func:`trace_table`'s."""
+    time, v_left, v_right = launches
+    batch, samples = len(v_left), len(time)
+    columns = {sensor_column(b): np.asarray(values).reshape(-1) for b, values in forces.items()}
     table = pd.DataFrame(
         {
             "source": "simulation",
             "model": model_name,
-            "N": result.model.n_beads,
+            "N": n_beads,
             "shot": np.repeat(np.arange(first_shot, first_shot + batch), samples),
             "kind": kind,
             "amplitude": np.repeat(np.arange(batch), samples),
-            "v0_left_m_s": np.repeat(result.v_left, samples),
-            "v0_right_m_s": np.repeat(result.v_right, samples),
-            "t_s": np.tile(result.time, batch),
-            **{name: values.reshape(-1) for name, values in columns.items()},
+            "v0_left_m_s": np.repeat(v_left, samples),
+            "v0_right_m_s": np.repeat(v_right, samples),
+            "t_s": np.tile(time, batch),
+            **columns,
         }
     )
     return table[list(META_COLUMNS) + list(columns)]
@@ -99,22 +111,107 @@ def shot_time_step(model: ChainModel, launch_speeds, dt: float | None, record_in
     return record_interval / math.ceil(record_interval / dt)
 
 
+def simulate_launches(
+    model: ChainModel,
+    launch_speeds,
+    *,
+    duration: float = 2.6e-3,
+    dt: float | None = None,
+    record_interval: float = DEFAULT_RECORD_INTERVAL,
+    max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
+    contacts="all",
+) -> list[SimulationResult]:
+    """The paper's launches for a sweep of speeds, integrated once: for each speed V0 a
+    collision (+V0 on bead 1, -V0 on bead N) and a reference (+V0 on bead 1 alone), in
+    two batches of one thread pool with one time step (:func:`shot_time_step`).
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain.
+    launch_speeds : sequence of float
+        V0 per amplitude, m/s.
+    duration, dt, record_interval, max_energy_drift
+        As in :func:`chain.physics.simulation.simulate` (s).
+    contacts : "all" or sequence of int
+        Contacts recorded (sensor springs and end forces are always kept).
+
+    Returns
+    -------
+    list of SimulationResult
+        The collision batch, then the reference batch.
+    """
+    speeds = np.asarray(launch_speeds, dtype=float)
+    if speeds.ndim != 1 or speeds.size == 0 or np.any(~np.isfinite(speeds)) or np.any(speeds <= 0):
+        raise ParameterError(f"launch_speeds must be positive m/s values, got {launch_speeds!r}")
+    # Both batches in one thread pool: every core busy until the last launch.
+    return simulate_many(
+        [{"v_right": speeds}, {"v_right": 0.0 * speeds}],
+        model=model,
+        v_left=speeds,
+        duration=duration,
+        dt=shot_time_step(model, speeds, dt, record_interval),
+        record_interval=record_interval,
+        max_energy_drift=max_energy_drift,
+        contacts=contacts,
+        beads=(),
+    )
+
+
+def shot_tables(
+    launches: Sequence[SimulationResult], sensor_beads, *, model_name: str, readout: str = "felt"
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The trace table and the runs of :func:`simulate_launches`' launches: collision
+    shots 0..A-1 then reference shots A..2A-1, read at ``sensor_beads``.
+
+    Parameters
+    ----------
+    launches : sequence of SimulationResult
+        The collision and the reference batch.
+    sensor_beads : sequence of int
+        Beads read, S1 first.
+    model_name : str
+        Name written in the ``model`` column.
+    readout : {"felt", "sensor"}
+        As in :func:`trace_table`.
+    """
+    tables, runs = [], []
+    for offset, (kind, result) in enumerate(zip(("collision", "reference"), launches, strict=True)):
+        first, count = offset * len(result.v_left), len(result.v_left)
+        tables.append(trace_table(result, sensor_beads, kind=kind, model_name=model_name,
+                                  readout=readout, first_shot=first))  # fmt: skip
+        runs.append(
+            pd.DataFrame(
+                {
+                    "model": model_name,
+                    "N": result.model.n_beads,
+                    "shot": np.arange(first, first + count),
+                    "kind": kind,
+                    "amplitude": np.arange(count),
+                    "v0_left_m_s": result.v_left,
+                    "v0_right_m_s": result.v_right,
+                    "energy_drift": result.energy_drift,
+                    "dt_s": result.dt,
+                    "initial_energy_J": result.total_energy[:, 0],
+                    "dissipated_energy_J": result.dissipated_energy[:, -1],
+                }
+            )
+        )
+    return pd.concat(tables, ignore_index=True), pd.concat(runs, ignore_index=True)
+
+
 def simulate_shots(
     model: ChainModel,
     launch_speeds,
     sensor_beads,
     *,
     model_name: str,
-    duration: float = 2.6e-3,
-    dt: float | None = None,
-    record_interval: float = DEFAULT_RECORD_INTERVAL,
     readout: str = "felt",
-    max_energy_drift: float = DEFAULT_MAX_ENERGY_DRIFT,
+    **simulation,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The paper's simulation protocol for a sweep of launch speeds.
-
-    For each speed V0: a collision shot (+V0 on bead 1, -V0 on bead N) and a reference
-    shot (+V0 on bead 1 alone), all in two batched integrator calls with one time step.
+    """The paper's simulation protocol for a sweep of launch speeds, read at the sensor
+    beads: :func:`simulate_launches` recording only what the readout reads, then
+    :func:`shot_tables`.
 
     Parameters
     ----------
@@ -126,10 +223,11 @@ def simulate_shots(
         Beads to record, S1 first (paper: 9, 17 for N = 25; 10, 17 for N = 26).
     model_name : str
         Name written in the ``model`` column.
-    duration, dt, record_interval, max_energy_drift
-        As in :func:`simulate`.
     readout : {"felt", "sensor"}
         As in :func:`trace_table`.
+    **simulation
+        ``duration``, ``dt``, ``record_interval``, ``max_energy_drift`` (s), as
+        :func:`simulate_launches`'.
 
     Returns
     -------
@@ -139,53 +237,56 @@ def simulate_shots(
         One row per shot: shot, kind, amplitude, v0 values, energy_drift, dt_s,
         final_energy_J, dissipated_energy_J.
     """
-    speeds = np.asarray(launch_speeds, dtype=float)
-    if speeds.ndim != 1 or speeds.size == 0 or np.any(~np.isfinite(speeds)) or np.any(speeds <= 0):
-        raise ParameterError(f"launch_speeds must be positive m/s values, got {launch_speeds!r}")
-    dt = shot_time_step(model, speeds, dt, record_interval)
-    tables = []
-    runs = []
-    kinds = ("collision", "reference")
-    # Both batches in one thread pool: every core busy until the last launch.
-    results = simulate_many(
-        [{"v_right": speeds}, {"v_right": 0.0 * speeds}],
-        model=model,
-        v_left=speeds,
-        duration=duration,
-        dt=dt,
-        record_interval=record_interval,
-        max_energy_drift=max_energy_drift,
-        # Record only what the readout reads (sensor springs are always kept).
-        contacts=felt_contacts(model, sensor_beads) if readout == "felt" else (),
-        beads=(),
-    )
-    for offset, (kind, result) in enumerate(zip(kinds, results, strict=True)):
-        first = offset * len(speeds)
-        tables.append(
-            trace_table(
-                result,
-                sensor_beads,
-                kind=kind,
-                model_name=model_name,
-                readout=readout,
-                first_shot=first,
-            )
+    contacts = felt_contacts(model, sensor_beads) if readout == "felt" else ()
+    launches = simulate_launches(model, launch_speeds, contacts=contacts, **simulation)
+    return shot_tables(launches, sensor_beads, model_name=model_name, readout=readout)
+
+
+def save_readings(launches: Sequence[SimulationResult], path) -> None:
+    """Every bead's felt force of :func:`simulate_launches`' launches (their contacts all
+    recorded), ``.npz`` without pickles: ``time_s`` (S,), ``v0_left_m_s`` and
+    ``v0_right_m_s`` (2A,), ``force_N`` (2A, N, S), collision shots then reference
+    shots, as :func:`shot_tables` numbers them. Written atomically.
+
+    Parameters
+    ----------
+    launches : sequence of SimulationResult
+        The collision and the reference batch.
+    path : path
+        The ``.npz`` file.
+    """
+    beads = range(1, launches[0].model.n_beads + 1)
+    force = np.concatenate([np.stack([r.force_felt(b) for b in beads], axis=1) for r in launches])
+    with atomic_output(path) as temporary, open(temporary, "wb") as stream:
+        np.savez(
+            stream,
+            time_s=launches[0].time,
+            v0_left_m_s=np.concatenate([r.v_left for r in launches]),
+            v0_right_m_s=np.concatenate([r.v_right for r in launches]),
+            force_N=force,
         )
-        runs.append(
-            pd.DataFrame(
-                {
-                    "model": model_name,
-                    "N": model.n_beads,
-                    "shot": np.arange(first, first + len(speeds)),
-                    "kind": kind,
-                    "amplitude": np.arange(len(speeds)),
-                    "v0_left_m_s": result.v_left,
-                    "v0_right_m_s": result.v_right,
-                    "energy_drift": result.energy_drift,
-                    "dt_s": result.dt,
-                    "initial_energy_J": result.total_energy[:, 0],
-                    "dissipated_energy_J": result.dissipated_energy[:, -1],
-                }
-            )
-        )
-    return pd.concat(tables, ignore_index=True), pd.concat(runs, ignore_index=True)
+
+
+def readings_table(path, beads, *, model_name: str) -> pd.DataFrame:
+    """The trace table at ``beads`` of the launches :func:`save_readings` wrote: the
+    table :func:`simulate_shots` would give for those beads (same values, bit for bit).
+
+    Parameters
+    ----------
+    path : path
+        The ``.npz`` file.
+    beads : sequence of int
+        Beads read, S1 first.
+    model_name : str
+        Name written in the ``model`` column.
+    """
+    with np.load(path, allow_pickle=False) as saved:
+        time, v_left, v_right, force = (saved[k] for k in ("time_s", "v0_left_m_s",
+                                                          "v0_right_m_s", "force_N"))  # fmt: skip
+    count, tables = len(v_left) // 2, []
+    for offset, kind in enumerate(("collision", "reference")):
+        shots = slice(offset * count, (offset + 1) * count)
+        forces = {b: force[shots, b - 1] for b in beads}
+        launches = (time, v_left[shots], v_right[shots])
+        tables.append(launch_table(launches, forces, force.shape[1], kind, model_name, shots.start))
+    return pd.concat(tables, ignore_index=True)

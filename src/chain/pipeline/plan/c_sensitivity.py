@@ -1,6 +1,7 @@
 """The C-sensitivity study's facts: its choices (estimator, eta, sensor pair, amplitude
 range, one at a time from the headline choice) and its simulations, every sensor bead
-of every pair recorded (:mod:`chain.studies.c_sensitivity`)."""
+of every pair recorded (:mod:`chain.studies.c_sensitivity`): a configured model's
+simulate job records those of its eta, the study's own rule the others."""
 
 from __future__ import annotations
 
@@ -27,12 +28,6 @@ class CSensitivityPlan:
         the run's speeds)."""
         return sensitivity_plan(self.plan.config, list(self.plan.speeds))
 
-    @property
-    def every_estimator(self) -> dict:
-        """:attr:`choices` without the main estimator (the job computes the table for
-        every estimator as the headline one)."""
-        return {k: v for k, v in self.choices.items() if k != "main_estimator"}
-
     def jobs(self) -> list[dict]:
         """The study's simulations, per eta then chain: every bead of every sensor pair
         recorded (:meth:`RunPlan.simulate_job` inputs)."""
@@ -44,3 +39,29 @@ class CSensitivityPlan:
                 name = f"eta{eta * 1e6:.3g}us"
                 jobs.append(self.plan.simulate_job(name, n, eta_s=eta, sensors=beads))
         return jobs
+
+    def recorded_by(self, job: dict) -> str | None:
+        """The configured model whose simulate job recorded the shots of ``job`` (one of
+        :meth:`jobs`; its readings hold every bead's felt force), or None: a model with
+        the same eta, read out as the felt force."""
+        if job["readout"] != "felt":
+            return None
+        return next((m for m, eta in self.plan.models.items() if eta == job["eta_s"]), None)
+
+    def readings(self) -> list[tuple[str, str, dict]]:
+        """Where each simulation of :meth:`jobs` is recorded (every bead's felt force),
+        in order: (rule, output, wildcards) of the configured model's ``simulate`` job
+        (:meth:`recorded_by`), else of the study's own ``c_sensitivity_simulate`` job
+        (wildcards: ``eta``, the eta's index in the choices, and ``N``)."""
+        etas, found = self.choices["eta_s"], []
+        for job in self.jobs():
+            model, n = self.recorded_by(job), job["N"]
+            eta = {"eta": etas.index(job["eta_s"]), "N": n}
+            found.append(("simulate", "readings", {"model": model, "N": n}) if model
+                         else ("c_sensitivity_simulate", "readings", eta))  # fmt: skip
+        return found
+
+    def job(self, eta: int, n_beads: int) -> dict:
+        """The simulation of the ``eta``-th eta of the choices on the chain of N beads."""
+        wanted = self.choices["eta_s"][int(eta)]
+        return next(j for j in self.jobs() if j["eta_s"] == wanted and j["N"] == int(n_beads))

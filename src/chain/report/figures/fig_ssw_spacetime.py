@@ -2,15 +2,15 @@
 
 One panel per chain (the paper's chains on top, the long chains of config
 ``long_chains`` below, where the SSW has room to run as its own line): the contact force
-of one collision at every recorded sample (the recording's own resolution, 1 us x 1
-contact in the paper run) over time (x) and contact index (y), divided by the incident
-amplitude F_m, on a logarithmic colour scale from the tracking floor (0.1 % of F_m, white
-below) so that a 1 % wave shows. Over it, the two
+of one collision over time (x, in the panel's resolution: each column the largest force
+of its time bin, :func:`chain.analysis.ssw_track.pooled_field`) and contact index (y),
+divided by the incident amplitude F_m, on a logarithmic colour scale from the tracking
+floor (0.1 % of F_m, white below) so that a 1 % wave shows. Over it, the two
 main waves (incident dashed, crossed solid: peak times at each contact) and the tracked
 SSW (crosses, where it is separated). Top right: the SSW amplitude over F_m against the
 distance from the collision point, every shot of every model and chain; a series that
 is never separated says so in the legend. Everything drawn comes from
-``ssw_track.csv`` and the field file of the ``ssw_track`` rule; nothing is computed here.
+``ssw_track.csv`` and the fields the simulations recorded; nothing is computed here.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import pandas as pd
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
-from chain.analysis.ssw_track import TRACK_FLOOR
+from chain.analysis.ssw_track import TRACK_FLOOR, Field
 from chain.report.figures.style import (
     LSTW_COLOR,
     RSTW_COLOR,
@@ -38,13 +38,12 @@ WAVE_COLORS = {"LSTW": LSTW_COLOR, "RSTW": RSTW_COLOR}
 TRACK_COLOR = "#00e676"
 
 
-def field_image(field: pd.DataFrame, f_m_N: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Time (us), contact numbers and force / F_m (contacts x samples) of a field file,
-    NaN below the tracking floor (drawn white)."""
-    columns = [c for c in field.columns if c.startswith("contact_")]
-    contacts = np.array([int(c.split("_")[1]) for c in columns])
-    ratio = field[columns].to_numpy(float).T / f_m_N
-    return field["t_us"].to_numpy(float), contacts, np.where(ratio >= TRACK_FLOOR, ratio, np.nan)
+def field_image(field: Field, shot: int, f_m_N: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time (us), contact numbers and force / F_m (contacts x bins) of one shot of a
+    pooled field, NaN below the tracking floor (drawn white)."""
+    ratio = field.force_N[shot].astype(float) / f_m_N
+    contacts = np.arange(1, ratio.shape[0] + 1)
+    return field.time_us, contacts, np.where(ratio >= TRACK_FLOOR, ratio, np.nan)
 
 
 def draw_field(ax, time_us, contacts, ratio):
@@ -130,10 +129,10 @@ def ssw_series(track: pd.DataFrame) -> list[dict]:
 
 
 def fig_ssw_spacetime(
-    fields: dict[int, pd.DataFrame],
+    fields: dict[int, tuple[Field, int]],
     track: pd.DataFrame,
     model: str,
-    long_fields: dict[int, pd.DataFrame] | None = None,
+    long_fields: dict[int, tuple[Field, int]] | None = None,
 ) -> Figure:
     """The space-time figure: field of one collision per chain of ``model`` (the paper's
     chains on top, the long chains below), and SSW amplitude against distance for every
@@ -142,8 +141,7 @@ def fig_ssw_spacetime(
     Parameters
     ----------
     fields : dict
-        N -> field table of the shown collision (``<model>_N<N>_field.csv``), the
-        paper's chains.
+        N -> (pooled field of the chain's collisions, shot shown), the paper's chains.
     track : DataFrame
         ``ssw_track.csv``.
     model : str
@@ -172,12 +170,12 @@ def fig_ssw_spacetime(
     return fig
 
 
-def _field_panel(ax, n: int, field: pd.DataFrame, track: pd.DataFrame, model: str):
-    """One chain's field with its waves and tracked SSW; returns the mesh."""
-    shot = int(field["shot"].iloc[0])
+def _field_panel(ax, n: int, field: tuple[Field, int], track: pd.DataFrame, model: str):
+    """One chain's field of the shot shown, with its waves and tracked SSW; the mesh."""
+    pooled, shot = field
     rows = track[(track["model"] == model) & (track["N"] == n) & (track["shot"] == shot)]
     f_m = float(rows["F_m_N"].iloc[0])
-    mesh = draw_field(ax, *field_image(field, f_m))
+    mesh = draw_field(ax, *field_image(pooled, shot, f_m))
     draw_waves(ax, rows)
     ax.set_title(f"{model}, N = {n}, F$_m$ = {f_m:.0f} N", loc="left")
     return mesh
