@@ -31,8 +31,10 @@ CHECKOUT = Path(str(workflow.current_basedir)).parents[1]
 PLAN = RunPlan(config, provenance=run_provenance(config, CHECKOUT))
 OUT = PLAN.out
 ENV = "../envs/hertzchain.yaml"
-#: Commands that run jobs (not a dry run, a report or a list) make the store's folder.
-MAKES_FILES = not (workflow.dryrun or workflow.touch)
+#: Commands that run jobs make the store's folder and discard damaged entries; a dry run
+#: only reports. Snakemake sets workflow.dryrun only after it has read the Snakefile
+#: (9.27.1); its output settings already say whether this is a dry run.
+MAKES_FILES = not (workflow.output_settings.dryrun or workflow.dryrun or workflow.touch)
 try:
     STORE = open_store(os.environ, trusted=[Path.cwd(), CHECKOUT], create=MAKES_FILES)
 except StoreError as error:
