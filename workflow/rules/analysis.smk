@@ -1,6 +1,7 @@
 # The analysis: pulses (cos^6 fits) of every trace file, then the crossing delays, the
 # secondary solitary waves (SSW) and their fits, and the SSW along the chain, as the
-# contract tables. Well under a second per trace file: each table is one job.
+# contract tables. Well under a second per trace file; a table and its fits are one
+# job (the fits take milliseconds, a job's start-up a second).
 
 
 rule pulses:
@@ -29,29 +30,13 @@ rule pulses:
         "../scripts/pulses.py"
 
 
-rule delays:
+rule delay_fits:
     input:
         pulses=made("pulses", "table"),
         selection=selection_files,
     output:
-        table=stored("delays", "tables/delays.csv"),
-        sums=stored("delays", "SHA256SUMS"),
-    log:
-        stored("delays", "log"),
-    benchmark:
-        stored("delays", "benchmark.tsv")
-    priority: 1
-    conda:
-        ENV
-    script:
-        "../scripts/delays.py"
-
-
-rule delay_fits:
-    input:
-        delays=made("delays", "table"),
-    output:
-        table=report(
+        delays=stored("delay_fits", "tables/delays.csv"),
+        fits=report(
             stored("delay_fits", "tables/delay_fits.csv"),
             caption="../report/delay_fits.rst",
             category="Tables",
@@ -74,7 +59,12 @@ rule ssw:
         pulses=made("pulses", "table"),
         selection=selection_files,
     output:
-        table=stored("ssw", "tables/ssw.csv"),
+        ssw=stored("ssw", "tables/ssw.csv"),
+        fits=report(
+            stored("ssw", "tables/ssw_fits.csv"),
+            caption="../report/ssw_fits.rst",
+            category="Tables",
+        ),
         sums=stored("ssw", "SHA256SUMS"),
     log:
         stored("ssw", "log"),
@@ -90,27 +80,6 @@ rule ssw:
         estimator=config["analysis"]["main_estimator"],
     script:
         "../scripts/ssw.py"
-
-
-rule ssw_fits:
-    input:
-        ssw=made("ssw", "table"),
-    output:
-        table=report(
-            stored("ssw_fits", "tables/ssw_fits.csv"),
-            caption="../report/ssw_fits.rst",
-            category="Tables",
-        ),
-        sums=stored("ssw_fits", "SHA256SUMS"),
-    log:
-        stored("ssw_fits", "log"),
-    benchmark:
-        stored("ssw_fits", "benchmark.tsv")
-    priority: 1
-    conda:
-        ENV
-    script:
-        "../scripts/ssw_fits.py"
 
 
 rule ssw_speed:
@@ -140,7 +109,13 @@ rule ssw_speed:
         "../scripts/ssw_speed.py"
 
 
-for table in ("pulses", "delays", "delay_fits", "ssw", "ssw_fits"):
-    publish(f"tables/{table}.csv", table, "table")
+for path, rule, name in [
+    ("pulses", "pulses", "table"),
+    ("delays", "delay_fits", "delays"),
+    ("delay_fits", "delay_fits", "fits"),
+    ("ssw", "ssw", "ssw"),
+    ("ssw_fits", "ssw", "fits"),
+]:
+    publish(f"tables/{path}.csv", rule, name)
 publish("tables/ssw_track.csv", "ssw_speed", "track")
 publish("tables/ssw_speed.csv", "ssw_speed", "speed")

@@ -34,7 +34,7 @@ rule fig2_experiment_traces:
             shown=config["figures"]["traces_N"] or ()
         ),
         pulses=made("pulses", "table"),
-        ssw=made("ssw", "table"),
+        ssw=made("ssw", "ssw"),
         selection=selection_files,
     output:
         pdf=stored("fig2_experiment_traces", "figures/fig2_experiment_traces.pdf"),
@@ -68,7 +68,7 @@ rule fig3_simulation_traces:
             for n in PLAN.traces_n
         ],
         pulses=made("pulses", "table"),
-        ssw=made("ssw", "table"),
+        ssw=made("ssw", "ssw"),
     output:
         pdf=stored("fig3_simulation_traces", "figures/fig3_simulation_traces.pdf"),
         png=report(
@@ -95,8 +95,8 @@ rule fig3_simulation_traces:
 
 rule fig4_delay_vs_force:
     input:
-        delays=made("delays", "table"),
-        fits=made("delay_fits", "table"),
+        delays=made("delay_fits", "delays"),
+        fits=made("delay_fits", "fits"),
     output:
         pdf=stored("fig4_delay_vs_force", "figures/fig4_delay_vs_force.pdf"),
         png=report(
@@ -123,8 +123,8 @@ rule fig4_delay_vs_force:
 # At the end of the longest chain of tables: started before shorter figures.
 rule fig5_ssw_vs_force:
     input:
-        ssw=made("ssw", "table"),
-        fits=made("ssw_fits", "table"),
+        ssw=made("ssw", "ssw"),
+        fits=made("ssw", "fits"),
         track=made("ssw_speed", "track"),
         speed=made("ssw_speed", "speed"),
     output:
@@ -192,7 +192,7 @@ rule ssw_spacetime:
 
 rule fig_parity_ssw_vs_N:
     input:
-        fits=made("ssw_fits", "table"),
+        fits=made("ssw", "fits"),
     output:
         pdf=stored("fig_parity_ssw_vs_N", "figures/fig_parity_ssw_vs_N.pdf"),
         png=report(

@@ -1,6 +1,5 @@
 # The report: summary.json (the run's numbers beside the paper's, with the sections the
-# studies add), summary.md from it (its own job, so that rewording the table reruns
-# nothing else), article.pdf (compiled by the typst package from
+# studies add) and summary.md from it, article.pdf (compiled by the typst package from
 # workflow/report/article.typ with the run's numbers and figures), and the run folder:
 # plain copies of every file the run shows, checked against the digests stored with
 # them, and their SHA256SUMS. Included last: it gathers what the other files publish.
@@ -13,11 +12,11 @@ rule summary:
             for part, (_, tables) in SUMMARY_PARTS.items()
             for name, (rule, output, wildcards) in tables.items()
         },
-        delay_fits=made("delay_fits", "table"),
-        ssw_fits=made("ssw_fits", "table"),
+        delay_fits=made("delay_fits", "fits"),
+        ssw_fits=made("ssw", "fits"),
         pulses=made("pulses", "table"),
-        delays=made("delays", "table"),
-        ssw=made("ssw", "table"),
+        delays=made("delay_fits", "delays"),
+        ssw=made("ssw", "ssw"),
         ssw_speed=made("ssw_speed", "speed"),
         selection=selection_files,
         runs=lambda w: [
@@ -27,6 +26,11 @@ rule summary:
         ],
     output:
         json=stored("summary", "summary.json"),
+        md=report(
+            stored("summary", "summary.md"),
+            caption="../report/summary.rst",
+            category="Summary",
+        ),
         sums=stored("summary", "SHA256SUMS"),
     log:
         stored("summary", "log"),
@@ -54,32 +58,12 @@ rule summary:
         "../scripts/summary.py"
 
 
-rule summary_md:
-    input:
-        json=made("summary", "json"),
-    output:
-        md=report(
-            stored("summary_md", "summary.md"),
-            caption="../report/summary.rst",
-            category="Summary",
-        ),
-        sums=stored("summary_md", "SHA256SUMS"),
-    log:
-        stored("summary_md", "log"),
-    benchmark:
-        stored("summary_md", "benchmark.tsv")
-    conda:
-        ENV
-    script:
-        "../scripts/summary_md.py"
-
-
 rule article:
     input:
         source=CHECKOUT / "workflow" / "report" / "article.typ",
         summary=made("summary", "json"),
-        delays=made("delays", "table"),
-        ssw=made("ssw", "table"),
+        delays=made("delay_fits", "delays"),
+        ssw=made("ssw", "ssw"),
         figures=lambda w: [
             output_of(rule, name, **wildcards)
             for path, (rule, name, wildcards) in RUN_FOLDER.items()
@@ -104,7 +88,7 @@ rule article:
 
 for path, rule, name in [
     ("summary.json", "summary", "json"),
-    ("summary.md", "summary_md", "md"),
+    ("summary.md", "summary", "md"),
     ("article.pdf", "article", "pdf"),
 ]:
     publish(path, rule, name)

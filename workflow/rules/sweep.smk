@@ -6,8 +6,8 @@
 
 rule sweep_table:
     input:
-        delay_fits=made("delay_fits", "table"),
-        ssw_fits=made("ssw_fits", "table"),
+        delay_fits=made("delay_fits", "fits"),
+        ssw_fits=made("ssw", "fits"),
     output:
         table=report(
             stored("sweep_table", "tables/sweep.csv"),

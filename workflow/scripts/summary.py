@@ -1,6 +1,7 @@
 """summary.json: the run's numbers beside the paper's (chain.report.numbers.summary),
 with the sections the studies add (each part's function of its tables, as its rule file
-names it: params.parts)."""
+names it: params.parts); and summary.md, its side-by-side table
+(chain.report.text.markdown), written from the file."""
 
 import importlib
 
@@ -10,6 +11,7 @@ from _logging import done, start
 
 from chain.report.numbers.claims import with_claims
 from chain.report.numbers.summary import build_summary, write_summary_json
+from chain.report.text.markdown import write_summary_markdown
 
 log = start(snakemake)
 p, i = snakemake.params, snakemake.input
@@ -47,4 +49,5 @@ write_summary_json(summary, snakemake.output.json)
 log.info("max energy drift of conservative runs: %s", summary["max_energy_drift"])
 log.info("flagged rows: %s", summary["flagged"])
 log.info("selection: %s", summary["selection"])
+write_summary_markdown(snakemake.output.json, snakemake.output.md)
 done(snakemake)
