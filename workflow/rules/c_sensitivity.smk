@@ -2,7 +2,8 @@
 # pair, amplitude range, one at a time from the headline choice, the run's main
 # estimator), on simulated shots read at every bead of every sensor pair
 # (chain.studies.c_sensitivity): those of a configured model's eta as its simulate job
-# recorded them, the others simulated by c_sensitivity_simulate.
+# recorded them, the others simulated by c_sensitivity_simulate (every chain of an eta
+# in one job: a third of a second of work each).
 
 from chain.pipeline.plan.c_sensitivity import CSensitivityPlan
 
@@ -11,17 +12,20 @@ C_SENSITIVITY = CSensitivityPlan(PLAN)
 
 rule c_sensitivity_simulate:
     output:
-        readings=stored("c_sensitivity_simulate", "readings.npz", "eta{eta}_N{N}"),
-        sums=stored("c_sensitivity_simulate", "SHA256SUMS", "eta{eta}_N{N}"),
+        **{
+            f"N{n}": stored("c_sensitivity_simulate", f"readings_N{n}.npz", "eta{eta}")
+            for n in PLAN.chains
+        },
+        sums=stored("c_sensitivity_simulate", "SHA256SUMS", "eta{eta}"),
     log:
-        stored("c_sensitivity_simulate", "log", "eta{eta}_N{N}"),
+        stored("c_sensitivity_simulate", "log", "eta{eta}"),
     benchmark:
-        stored("c_sensitivity_simulate", "benchmark.tsv", "eta{eta}_N{N}")
+        stored("c_sensitivity_simulate", "benchmark.tsv", "eta{eta}")
     priority: 2
     conda:
         ENV
     params:
-        job=lambda w: C_SENSITIVITY.job(w.eta, w.N),
+        jobs=lambda w: [C_SENSITIVITY.job(w.eta, n) for n in PLAN.chains],
     script:
         "../scripts/c_sensitivity_simulate.py"
 

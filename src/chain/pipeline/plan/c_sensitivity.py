@@ -51,14 +51,14 @@ class CSensitivityPlan:
     def readings(self) -> list[tuple[str, str, dict]]:
         """Where each simulation of :meth:`jobs` is recorded (every bead's felt force),
         in order: (rule, output, wildcards) of the configured model's ``simulate`` job
-        (:meth:`recorded_by`), else of the study's own ``c_sensitivity_simulate`` job
-        (wildcards: ``eta``, the eta's index in the choices, and ``N``)."""
+        (:meth:`recorded_by`), else of the study's own ``c_sensitivity_simulate`` job of
+        its eta (wildcard ``eta``: the eta's index in the choices; output ``N<N>``)."""
         etas, found = self.choices["eta_s"], []
         for job in self.jobs():
             model, n = self.recorded_by(job), job["N"]
-            eta = {"eta": etas.index(job["eta_s"]), "N": n}
+            eta = {"eta": etas.index(job["eta_s"])}
             found.append(("simulate", "readings", {"model": model, "N": n}) if model
-                         else ("c_sensitivity_simulate", "readings", eta))  # fmt: skip
+                         else ("c_sensitivity_simulate", f"N{n}", eta))  # fmt: skip
         return found
 
     def job(self, eta: int, n_beads: int) -> dict:
