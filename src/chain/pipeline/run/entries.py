@@ -146,6 +146,8 @@ def seal(outputs: Iterable[str], sums: str, inputs: dict[str, str]) -> None:
     if group:
         for folder in {entry, *(entry / p for f in files for p in f.relative_to(entry).parents)}:
             os.chmod(folder, 0o2770)
+        if (entry / "log").is_file():  # the job's log, for the others' run folders
+            os.chmod(entry / "log", 0o640)
     write_text_atomic("".join(lines), sums)
     os.chmod(sums, 0o440 if group else stat.S_IMODE(os.stat(sums).st_mode) & ~0o222)
 

@@ -100,10 +100,12 @@ def _copy_checked(source: Path, target: Path) -> str:
 
 
 def _copy_records(entry: Path, folder: Path) -> None:
-    """The log and benchmark file of the job of ``entry``, into the run folder."""
+    """The log and benchmark file of the job of ``entry``, into the run folder (where
+    they can be read: in a group's store, another member's benchmark file has the mode
+    that member's umask gave it)."""
     match = ENTRY.match(entry.name)
     name = match["rule"] + (f"/{match['label']}" if match["label"] else "")
     for record, into in (("log", f"logs/{name}.log"), ("benchmark.tsv", f"benchmarks/{name}.tsv")):
-        if (entry / record).is_file():
+        if os.access(entry / record, os.R_OK):
             (folder / into).parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(entry / record, folder / into)
