@@ -1,27 +1,24 @@
-# What every rule file shares. The config's check and plan, the result store, and how one
-# rule names another's outputs.
-#
-# Every computing rule writes into the result store (results/.store, or
-# HERTZCHAIN_STORE), in a folder named by its rule, its wildcards and the key of its
-# recipe: stored(). The key hashes the job's params, its inputs (another job's folder,
-# or a file's SHA-256), the code its script runs and the package versions, so a job
-# whose recipe an earlier run computed finds its outputs there and Snakemake starts
-# nothing for it; a changed recipe is a new folder. A rule reads another's outputs
-# through output_of(); the run folder gets plain copies of what it shows (publish(),
-# rule run_folder). docs/architecture.md, docs/store.md.
+# What every rule file shares. The config's check and plan; the result store, where a
+# computing rule writes in a folder named by its recipe's key (stored(): a recipe an
+# earlier run computed is found there, and Snakemake starts nothing for it); how one rule
+# names another's outputs (made(), output_of()); what the run folder shows (publish()).
+# docs/architecture.md, docs/store.md.
 
 import functools
 import os
 import sys
 from pathlib import Path
 
+from snakemake import __version__ as SNAKEMAKE_VERSION
 from snakemake.exceptions import WorkflowError
+from snakemake.scheduling.job_scheduler import JobScheduler
 
 from chain.errors import ConfigError
 from chain.pipeline.config.check import check_config
 from chain.pipeline.plan.run_plan import RunPlan
 from chain.pipeline.provenance.record import run_provenance
 from chain.pipeline.run.recipe import Recipes, Wildcards
+from chain.pipeline.run.snakemake_patches import patch_snakemake
 from chain.pipeline.run.store_path import StoreError, open_store
 
 check_config(config)
@@ -50,6 +47,10 @@ if workflow.is_main_process:
         PLAN.experiment.check_datasets()
     except ConfigError as error:
         raise WorkflowError(str(error)) from None
+    # The scheduler's defects patched on the release the patches were written for
+    # (docs/upstream/README.md); any other release says so in one line.
+    for line in patch_snakemake(JobScheduler, SNAKEMAKE_VERSION):
+        print(line, file=sys.stderr)
 
 
 def stored(rule, file, label=""):
