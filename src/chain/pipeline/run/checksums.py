@@ -1,11 +1,8 @@
-"""The run folder's ``SHA256SUMS``: every file of a run folder that succeeded, with its
-SHA-256, in the format ``sha256sum -c SHA256SUMS`` reads (run from the folder).
-
-It certifies a complete run only: written once every target has succeeded, from the
-digests the run checked as it fetched and stored its results (a file changed since is
-then reported by ``sha256sum -c``), and removed as soon as a run starts work, so that a
-failed or interrupted run leaves none. Hidden files and folders (an interrupted copy's
-staging, Snakemake's ``.snakemake_timestamp``) are never listed.
+"""The run folder's ``SHA256SUMS``: every file of a run folder, with its SHA-256, in the
+format ``sha256sum -c SHA256SUMS`` reads (run from the folder), written by the run's
+last job (:mod:`chain.pipeline.run.publish`) from the digests it checked as it copied
+the files (a file changed since is then reported by ``sha256sum -c``). Hidden files and
+folders (an interrupted copy's temporary file) are never listed.
 """
 
 from __future__ import annotations
@@ -49,15 +46,10 @@ def write_checksums(folder: str | os.PathLike, digests: Mapping[str, str] = {}) 
     """
     lines = []
     for name in run_files(folder):
-        path = os.path.join(folder, name)
+        path = os.path.normpath(os.path.join(folder, name))
         lines.append(f"{digests.get(path) or file_digest(path)}  {name}\n")
     write_text_atomic("".join(lines), Path(folder) / CHECKSUMS)
     return Path(folder) / CHECKSUMS
-
-
-def remove_checksums(folder: str | os.PathLike) -> None:
-    """Remove ``<folder>/SHA256SUMS``: the folder no longer holds a complete run."""
-    (Path(folder) / CHECKSUMS).unlink(missing_ok=True)
 
 
 def checksum_problems(folder: str | os.PathLike) -> list[str]:

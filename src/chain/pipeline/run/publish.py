@@ -16,8 +16,8 @@ import shutil
 from collections.abc import Sequence
 from pathlib import Path
 
-from chain.atomic import atomic_output, write_text_atomic
-from chain.pipeline.run.checksums import run_files
+from chain.atomic import atomic_output
+from chain.pipeline.run.checksums import write_checksums
 from chain.pipeline.run.entries import (
     CHUNK,
     ENTRY,
@@ -25,7 +25,6 @@ from chain.pipeline.run.entries import (
     DamagedEntry,
     discard,
     entry_of,
-    file_digest,
     read_sums,
 )
 
@@ -54,15 +53,11 @@ def fill_run_folder(sources: Sequence[str], targets: Sequence[str], sums: str) -
         shutil.rmtree(folder / name, ignore_errors=True)
     digests = {}
     for source, target in zip(sources, targets, strict=True):
-        digests[os.path.abspath(target)] = _copy_checked(Path(source), Path(target))
+        digests[os.path.normpath(target)] = _copy_checked(Path(source), Path(target))
     entries = upstream({entry_of(source) for source in sources})
     for entry in entries:
         _copy_records(entry, folder)
-    listing = []
-    for name in run_files(folder):
-        path = os.path.abspath(folder / name)
-        listing.append(f"{digests.get(path) or file_digest(path)}  {name}\n")
-    write_text_atomic("".join(listing), sums)
+    write_checksums(folder, digests)
     return [f"{len(sources)} files copied from {len(entries)} stored jobs into {folder}"]
 
 
