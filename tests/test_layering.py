@@ -8,8 +8,8 @@ figures, and the report without an integrator.
       studies              -> physics, apparatus, analysis (simulate and analyse in-process)
       report               -> analysis, physics.theory/materials
     apparatus | analysis   (side by side, no arrow between them)
-    physics                -> errors only
-    errors, atomic, csv_text, traces, labels, sampling, _lazy
+    physics                -> errors, trust only
+    errors, trust, atomic, csv_text, traces, labels, sampling, _lazy
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ BOTTOM = {
     "chain",
     "chain._lazy",
     "chain.errors",
+    "chain.trust",
     "chain.atomic",
     "chain.csv_text",
     "chain.traces",
@@ -35,7 +36,7 @@ BOTTOM = {
 #: Wing -> the chain modules or wings (prefixes) it may import.
 ALLOWED = {
     "bottom": BOTTOM,
-    "physics": {"chain", "chain._lazy", "chain.errors", "chain.physics"},
+    "physics": {"chain", "chain._lazy", "chain.errors", "chain.trust", "chain.physics"},
     "apparatus": BOTTOM | {"chain.physics", "chain.apparatus"},
     "analysis": BOTTOM | {"chain.analysis"},
     "report": BOTTOM
@@ -279,25 +280,201 @@ def test_the_plan_is_in_parts_none_too_big():
                 assert len(methods) <= 20, f"{path.name}: {node.name}"
 
 
-WORKFLOW = PACKAGE.parents[1] / "workflow"
+CHECKOUT = PACKAGE.parents[1]
+WORKFLOW = CHECKOUT / "workflow"
+SNAKEFILE = CHECKOUT / "Snakefile"
 
 
-def test_rule_files_share_names_through_common_only():
-    """A name defined at the top of a rule file other than common.smk is used in that
-    file only: the includes' order makes nothing work by accident."""
-    files = {path: path.read_text() for path in (WORKFLOW / "rules").glob("*.smk")}
-    files[PACKAGE.parents[1] / "Snakefile"] = (PACKAGE.parents[1] / "Snakefile").read_text()
-    for path, text in files.items():
-        if path.name == "common.smk":
-            continue
-        defined = re.findall(r"^(?:def\s+(\w+)|(\w+)\s*=)", text, re.M)
-        for name in {a or b for a, b in defined}:
-            users = [p.name for p, t in files.items() if p != path and re.search(rf"\b{name}\b", t)]
-            assert not users, f"{name} of {path.name} used in {users}"
+def included_rule_files() -> list[Path]:
+    """The rule files, in the order the Snakefile includes them."""
+    names = re.findall(r'^include:\s*"([^"]+)"', SNAKEFILE.read_text(), re.M)
+    return [CHECKOUT / name for name in names]
+
+
+def compiled(path: Path) -> ast.Module:
+    """A Snakefile or rule file as Snakemake compiles it to Python (its own parser)."""
+    from types import SimpleNamespace
+
+    from snakemake.parser import parse
+    from snakemake.sourcecache import LocalSourceFile
+
+    def open_source(source, mode="r"):
+        return open(source.get_path_or_uri(secret_free=True), mode)
+
+    reader = SimpleNamespace(sourcecache=SimpleNamespace(open=open_source))
+    code, _ = parse(LocalSourceFile(str(path)), reader, {})
+    return ast.parse(code, filename=str(path))
+
+
+def bound(tree: ast.AST) -> set[str]:
+    """Every name ``tree`` binds, in any scope: assignments, loop and comprehension
+    targets, imports, definitions, arguments."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            names.add(node.id)
+        elif isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            names.add(node.name)
+        elif isinstance(node, ast.Import | ast.ImportFrom):
+            names |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        elif isinstance(node, ast.arg):
+            names.add(node.arg)
+        elif isinstance(node, ast.ExceptHandler) and node.name:
+            names.add(node.name)
+    return names
+
+
+def top_level(tree: ast.Module) -> set[str]:
+    """The names a file defines for the files included after it: those bound at module
+    level (in its top-level blocks too), but the functions Snakemake makes of rules."""
+    names = set()
+    todo = list(tree.body)
+    while todo:
+        node = todo.pop()
+        if isinstance(node, ast.For | ast.If | ast.While | ast.With | ast.Try):
+            todo += [*node.body, *node.orelse] if hasattr(node, "orelse") else node.body
+            targets = [node.target] if isinstance(node, ast.For) else []
+        elif isinstance(node, ast.Assign | ast.AnnAssign | ast.AugAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+        else:
+            targets = []
+        names |= {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+        if isinstance(node, ast.FunctionDef | ast.ClassDef) and not node.name.startswith("__"):
+            names.add(node.name)
+        elif isinstance(node, ast.Import | ast.ImportFrom):
+            names |= {(a.asname or a.name).split(".")[0] for a in node.names}
+    return names
+
+
+def snakemake_globals() -> set[str]:
+    """What Snakemake gives every Snakefile and rule file besides Python's builtins:
+    its workflow module's names and those it registers (workflow, rules, config, ...)."""
+    import builtins
+
+    import snakemake.api  # (snakemake.workflow imports itself through it)
+    import snakemake.ioflags
+    import snakemake.ioutils
+    import snakemake.workflow
+
+    names = dict(vars(snakemake.workflow))
+    snakemake.ioutils.register_in_globals(names)
+    snakemake.ioflags.register_in_globals(names)
+    extra = {"workflow", "rules", "checkpoints", "scatter", "gather", "storage", "config"}
+    return set(names) | set(dir(builtins)) | extra | {"shell", "pep", "access", "from_queue"}
+
+
+def test_rule_files_use_names_of_common_the_snakefile_or_files_before_them():
+    """A rule file reads only names it defines, Snakemake's, the Snakefile's imports, and
+    those of the rule files included before it (common.smk first): the include order
+    is the one dependency between them, and it is written in the Snakefile."""
+    files = included_rule_files()
+    assert files[0].name == "common.smk" and len(files) > 5, files
+    assert {p.name for p in files} == {p.name for p in (WORKFLOW / "rules").glob("*.smk")}
+    snakefile = compiled(SNAKEFILE)
+    known = snakemake_globals() | {
+        (a.asname or a.name).split(".")[0]
+        for node in snakefile.body
+        if isinstance(node, ast.Import | ast.ImportFrom)
+        for a in node.names
+    }
+    for path in files:
+        tree = compiled(path)
+        read = {
+            n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)
+        }
+        unknown = sorted(read - bound(tree) - known)
+        assert not unknown, f"{path.name} reads {unknown}, defined in no file included before it"
+        known |= top_level(tree)
+
+
+def test_the_name_check_catches_a_name_of_a_later_file(tmp_path):
+    """The test itself: a name read before the file that defines it is included."""
+    early, late = tmp_path / "early.smk", tmp_path / "late.smk"
+    early.write_text("X = LATER + 1\n\nrule a:\n    output:\n        f'{X}'\n")
+    late.write_text("LATER = 1\n")
+    tree = compiled(early)
+    read = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+    assert read - bound(tree) - snakemake_globals() == {"LATER"}
+    assert top_level(compiled(late)) == {"LATER"} and "X" in top_level(tree)
+
+
+def workflow_files() -> dict[Path, str]:
+    """The Snakefile and the rule files: path -> text."""
+    return {
+        path: path.read_text() for path in [SNAKEFILE, *sorted((WORKFLOW / "rules").glob("*.smk"))]
+    }
+
+
+def test_every_rule_is_written_out():
+    """No rule is made in a loop or under a condition (a ``rule`` keyword at the start
+    of its line, with a name, and no ``name:`` directive), and no script path is a
+    pattern: a reader finds each rule, and its script, by its name."""
+    for path, text in workflow_files().items():
+        assert not re.search(r"^[ \t]+rule\b", text, re.M), f"{path.name}: a rule inside a block"
+        assert not re.search(r"^rule\s*:", text, re.M), f"{path.name}: a rule without a name"
+        assert not re.search(r"^    name\s*:", text, re.M), f"{path.name}: a name: directive"
+        for script in re.findall(r"^\s+script:\s*\n?\s*(.+)$", text, re.M):
+            assert re.fullmatch(r'"[^"{}]+\.py"', script.strip()), f"{path.name}: {script}"
+
+
+@pytest.mark.workflow
+def test_every_rule_snakemake_lists_is_written_as_a_rule(tmp_path):
+    """``snakemake --list-rules`` (the paper config, in a folder of its own) lists
+    exactly the rules written as ``rule <name>:`` in the Snakefile and workflow/rules."""
+    import subprocess
+    import sys
+
+    result = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--snakefile", str(SNAKEFILE), "--directory",
+         str(tmp_path), "--configfile", str(CHECKOUT / "config.yaml"), "--list-rules"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300, stdin=subprocess.DEVNULL,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr[-3000:]
+    listed = set(result.stdout.split())
+    written = {name for text in workflow_files().values()
+               for name in re.findall(r"^rule (\w+):", text, re.M)}  # fmt: skip
+    assert listed == written and {"simulate", "pulses", "run_folder", "all"} <= listed
+
+
+#: The one module that replaces private methods of Snakemake's scheduler, on the release
+#: it was written for only (tests/test_snakemake_patches.py pins that release).
+PATCHES = PACKAGE / "pipeline" / "run" / "snakemake_patches.py"
+
+#: Reading a private attribute of a Snakemake object: the workflow, its rules, a script's
+#: ``snakemake``, a rule proxy, the scheduler, the DAG, a job.
+PRIVATE = re.compile(
+    r"\b(?:workflow|rules|checkpoints|snakemake|proxy|rule|scheduler|dag|job)"
+    r"(?:\.\w+)*\._(?!_)\w*"
+)
 
 
 def test_no_private_name_of_snakemake_is_read():
-    """Scripts are plain Snakemake scripts: nothing reads how Snakemake runs them."""
-    for root in (PACKAGE, WORKFLOW):
-        for path in root.rglob("*.py"):
-            assert "__real_file__" not in path.read_text(), path
+    """Scripts are plain Snakemake scripts and rule files read Snakemake's public names:
+    nothing in workflow/ reads an attribute whose name starts with ``_``, nothing in
+    src/ reads one of a Snakemake object (but :data:`PATCHES`), and nothing reads
+    ``__real_file__``."""
+    for path, text in workflow_files().items():
+        assert not re.search(r"\.\_(?!_)\w", text), path
+    for path in sorted(WORKFLOW.rglob("*.py")):
+        assert not re.search(r"\.\_(?!_)\w", path.read_text()), path
+    for path in sorted(PACKAGE.rglob("*.py")):
+        text = path.read_text()
+        assert "__real_file__" not in text, path
+        if path != PATCHES:
+            assert not PRIVATE.search(text), (path, PRIVATE.search(text)[0])
+    assert PRIVATE.search("x = workflow._executor_plugin") and PRIVATE.search("job._x")
+    assert not PRIVATE.search("workflow.dryrun") and not PRIVATE.search("self._firsts")
+
+
+def lines(path: Path) -> int:
+    return len(path.read_text().splitlines())
+
+
+def test_the_workflows_shared_code_stays_small():
+    """common.smk at most 150 lines, the pipeline's run room (store, recipes, run folder)
+    at most 800, and at most four modules of the library over 400."""
+    assert lines(WORKFLOW / "rules" / "common.smk") <= 150
+    run = {p.name: lines(p) for p in sorted((PACKAGE / "pipeline" / "run").glob("*.py"))}
+    assert sum(run.values()) <= 800, f"src/chain/pipeline/run/: {sum(run.values())} lines {run}"
+    large = {str(p.relative_to(PACKAGE)): lines(p) for p in PACKAGE.rglob("*.py") if lines(p) > 400}
+    assert len(large) <= 4, large

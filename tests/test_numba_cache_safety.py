@@ -5,7 +5,9 @@ numba unpickles a kernel's cache index before any check: an index planted by ano
 account runs its code. Shown with a planted index whose code only writes a marker file:
 numba runs it from a folder it trusts, and chain's kernels never read it from a folder
 of another account. The attack needs a folder owned by another user: as root, made here
-and given to uid 65534 (nobody); those tests are skipped for other users.
+and given to uid 65534 (nobody); those tests are skipped for other users. The sources'
+own __pycache__ is trusted as the sources are (chain.trust): one more open than them is
+passed over for a private folder of the user's.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 import pytest
 
 import chain
+from chain import trust
 from chain.physics import kernels, safe_cache
 from chain.physics.kernel_cache import SOURCES, sources_digest
 
@@ -90,6 +93,8 @@ def plant(cache_dir: Path, marker: Path) -> Path:
         kernels.__file__
     )
     folder.mkdir(parents=True)
+    for made in (cache_dir, folder):
+        made.chmod(0o700)  # whatever the umask
     index = kernels._integrate_part._cache._cache_file._index_name
     (folder / index).write_bytes(pickle.dumps(Planted(marker)))
     (folder / "kernels.sources.sha256").write_text(sources_digest(PHYSICS / s for s in SOURCES))
@@ -99,8 +104,8 @@ def plant(cache_dir: Path, marker: Path) -> Path:
 def private_folder(path: Path) -> Path:
     """A new folder for the test, no one else's, its chain of folders checked."""
     path.mkdir(mode=0o700)
-    if safe_cache.unsafe(path):
-        pytest.skip(f"the temporary folder is not private here: {safe_cache.unsafe(path)}")
+    if trust.problem(path):
+        pytest.skip(f"the temporary folder is not private here: {trust.problem(path)}")
     return path
 
 
@@ -175,7 +180,7 @@ def test_the_cache_folder_itself_is_never_shared(tmp_path):
     folder = private_folder(tmp_path / "numba")
     folder.chmod(0o1777)
     assert (
-        safe_cache.unsafe(folder)
+        trust.problem(folder)
         == f"{folder} has mode drwxrwxrwt: its group or others may write in it"
     )
 
@@ -213,9 +218,9 @@ def test_a_link_of_another_account_is_refused(tmp_path):
     target = private_folder(work / "target")
     link = work / "link"
     link.symlink_to(target)
-    assert safe_cache.unsafe(link) is None
+    assert trust.problem(link) is None
     os.lchown(link, NOBODY, NOBODY)
-    assert safe_cache.unsafe(link) == f"{link} is owned by uid {NOBODY} (nobody)"
+    assert trust.problem(link) == f"{link} is owned by uid {NOBODY} (nobody)"
 
 
 def test_every_cached_kernel_asks_first():
@@ -225,3 +230,52 @@ def test_every_cached_kernel_asks_first():
         assert "cache=True" not in text, path
         if "cache=CACHE" in text:
             assert "CACHE = safe_cache.allowed(__file__)" in text, path
+
+
+#: A module of one cached kernel, run twice: where its cache is, and whether it was hit.
+MODULE = """
+import numba
+from chain.physics import safe_cache
+CACHE = safe_cache.allowed(__file__)
+@numba.njit(cache=CACHE)
+def add_one(x):
+    return x + 1
+add_one(1)
+print(add_one._cache.cache_path, sum(add_one.stats.cache_hits.values()))
+"""
+
+
+@pytest.mark.parametrize(
+    ("sources_mode", "pycache_mode", "in_tree"),
+    [(0o775, 0o775, True), (0o755, 0o755, True), (0o755, 0o775, False), (0o755, 0o777, False)],
+    ids=["umask-002-clone", "umask-022-clone", "group-writable-pycache", "open-pycache"],
+)
+def test_pycache_is_trusted_as_its_sources_are(tmp_path, sources_mode, pycache_mode, in_tree):
+    """A __pycache__ no more open than its sources (a clone made under umask 002 or 022)
+    is used; one more open is passed over for a folder of the user's under their cache
+    directory, made 0700, where the second process finds what the first compiled.
+    Nothing is said either way, and nothing is written in a __pycache__ passed over."""
+    work = private_folder(tmp_path / "work")
+    sources = work / "src"
+    sources.mkdir()
+    (sources / "kernel.py").write_text(MODULE)
+    (sources / "__pycache__").mkdir()
+    sources.chmod(sources_mode)
+    (sources / "__pycache__").chmod(pycache_mode)
+    env = {**os.environ, "XDG_CACHE_HOME": str(work / "cache")}
+    env.pop("NUMBA_CACHE_DIR", None)
+    command = [sys.executable, "-B", str(sources / "kernel.py")]
+    done = [
+        subprocess.run(command, env=env, stdin=subprocess.DEVNULL, capture_output=True, text=True)
+        for _ in range(2)
+    ]
+    folder = sources / "__pycache__"
+    if not in_tree:
+        subpath = numba.core.caching._CacheLocator.get_suitable_cache_subpath(str(sources / "_.py"))
+        folder = work / "cache" / "numba" / subpath
+        made = [work / "cache", work / "cache" / "numba", folder]
+        assert [stat.S_IMODE(path.stat().st_mode) for path in made] == [0o700] * 3
+        assert list((sources / "__pycache__").iterdir()) == []
+    said = [run.stdout.split() for run in done]
+    assert said == [[str(folder), "0"], [str(folder), "1"]], [run.stderr for run in done]
+    assert not "".join(run.stderr for run in done)

@@ -20,6 +20,7 @@ from chain.pipeline.provenance.record import run_provenance
 from chain.pipeline.run.recipe import Recipes, Wildcards
 from chain.pipeline.run.snakemake_patches import patch_snakemake
 from chain.pipeline.run.store_path import StoreError, open_store
+from chain.trust import open_code_line
 
 check_config(config)
 
@@ -29,18 +30,21 @@ PLAN = RunPlan(config, provenance=run_provenance(config, CHECKOUT))
 OUT = PLAN.out
 ENV = "../envs/hertzchain.yaml"
 #: Commands that run jobs make the store's folder and discard damaged entries; a dry run
-#: only reports. Snakemake sets workflow.dryrun only after it has read the Snakefile
-#: (9.27.1); its output settings already say whether this is a dry run.
+#: only reports (its output settings say so while the Snakefile is read; dryrun not yet).
 MAKES_FILES = not (workflow.output_settings.dryrun or workflow.dryrun or workflow.touch)
 try:
-    STORE = open_store(os.environ, trusted=[Path.cwd(), CHECKOUT], create=MAKES_FILES)
+    # A store in a folder of the code the run executes is trusted as that code is.
+    CODE = [CHECKOUT, Path(workflow.basedir)]
+    STORE = open_store(os.environ, trusted=CODE, create=MAKES_FILES)
 except StoreError as error:
     raise WorkflowError(str(error)) from None
 RECIPES = Recipes(STORE)
 
 # What is said and checked once, before any job: in the process that runs the workflow,
-# not in a cluster job's.
+# not in a cluster job's. Whoever else may write the code may change what the run does.
 if workflow.is_main_process:
+    for line in filter(None, map(open_code_line, dict.fromkeys(CODE))):
+        print(line, file=sys.stderr)
     for line in RECIPES.check_entries(discard_damaged=MAKES_FILES):
         print(line, file=sys.stderr)
     try:
