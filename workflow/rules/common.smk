@@ -13,7 +13,6 @@ from snakemake import __version__ as SNAKEMAKE_VERSION
 from snakemake.exceptions import WorkflowError
 from snakemake.scheduling.job_scheduler import JobScheduler
 
-from chain.errors import ConfigError
 from chain.pipeline.config.check import check_config
 from chain.pipeline.plan.run_plan import RunPlan
 from chain.pipeline.provenance.record import run_provenance
@@ -29,6 +28,9 @@ CHECKOUT = Path(str(workflow.current_basedir)).parents[1]
 PLAN = RunPlan(config, provenance=run_provenance(config, CHECKOUT))
 OUT = PLAN.out
 ENV = "../envs/hertzchain.yaml"
+# Every file of the measured datasets checked, before anything is written.
+if workflow.is_main_process:
+    PLAN.experiment.check_datasets()
 #: Commands that run jobs make the store's folder and discard damaged entries; a dry run
 #: only reports (its output settings say so while the Snakefile is read; dryrun not yet).
 MAKES_FILES = not (workflow.output_settings.dryrun or workflow.dryrun or workflow.touch)
@@ -47,10 +49,6 @@ if workflow.is_main_process:
         print(line, file=sys.stderr)
     for line in RECIPES.check_entries(discard_damaged=MAKES_FILES):
         print(line, file=sys.stderr)
-    try:
-        PLAN.experiment.check_datasets()
-    except ConfigError as error:
-        raise WorkflowError(str(error)) from None
     # The scheduler's defects patched on the release the patches were written for
     # (docs/upstream/README.md); any other release says so in one line.
     for line in patch_snakemake(JobScheduler, SNAKEMAKE_VERSION):
