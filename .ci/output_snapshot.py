@@ -1,17 +1,25 @@
-"""Fingerprints of a run's finished outputs, for the live SLURM test's kill case.
+"""Fingerprints of the result store's finished entries, for the live SLURM test.
 
-    python .ci/output_snapshot.py record DIR RUN > before.tsv
+    python .ci/output_snapshot.py record DIR STORE > before.tsv
     python .ci/output_snapshot.py check DIR before.tsv
 
-`record` lists every file under DIR/results/RUN (less logs/ and benchmarks/, which
-jobs still running write into) that Snakemake has not marked incomplete, with its
-inode, modification time (ns) and SHA-256. A file is marked incomplete from the job's
-submission until its success is recorded: Snakemake's file persistence backend keeps
-one marker per output in DIR/.snakemake/incomplete/, named by the output's path in
-URL-safe base64 (split in chunks of the file-name limit, all but the last prefixed
-with "@"). The markers are read before the files, so a job that ends in between
-counts as unfinished. `check` exits 1, naming the files, if any listed file is gone
-or was rewritten (new inode, time or content): a rerun recomputed a finished output.
+Every job that computes writes into its own folder of the result store
+(DIR/STORE/<rule>-<wildcards>-<key>/, STORE relative to DIR, e.g. results/.store) and
+seals it with SHA256SUMS as it ends (docs/store.md). `record` lists every file of
+each *finished* entry with its inode, modification time (ns) and SHA-256, the entry's
+own log and benchmark file included: an entry is finished when it is sealed
+(SHA256SUMS present) and Snakemake marks none of its outputs incomplete. Snakemake
+marks a job's outputs incomplete from the job's submission until its success is
+recorded (by the job's own Snakemake on the node, or by the submitting one): its file
+persistence backend keeps one marker per output in DIR/.snakemake/incomplete/, named
+by the output's path in URL-safe base64 (split in chunks of the file-name limit, all
+but the last prefixed with "@"). The markers are read before the entries, so a job
+that ends in between counts as unfinished; an entry of a job still running (its log
+still written) or killed half-way (no seal, or outputs still marked) is left out.
+On stderr: how many entries are finished, and how many are not.
+
+`check` exits 1, naming the files, if any listed file is gone or was rewritten (new
+inode, time or content): a later run recomputed (or discarded) a finished result.
 """
 
 from __future__ import annotations
@@ -22,7 +30,7 @@ import os
 import sys
 from pathlib import Path
 
-SKIPPED = ("logs", "benchmarks")  # written by jobs still running, not outputs
+SEAL = "SHA256SUMS"
 
 
 def incomplete_outputs(workdir: Path) -> set[str]:
@@ -35,7 +43,10 @@ def incomplete_outputs(workdir: Path) -> set[str]:
                 continue
             chunks = Path(folder, name).relative_to(root).parts
             encoded = "".join(chunk.removeprefix("@") for chunk in chunks)
-            marked.add(os.path.normpath(base64.urlsafe_b64decode(encoded).decode()))
+            path = base64.urlsafe_b64decode(encoded).decode()
+            if os.path.isabs(path):
+                path = os.path.relpath(path, workdir)
+            marked.add(os.path.normpath(path))
     return marked
 
 
@@ -45,19 +56,26 @@ def fingerprint(path: Path) -> str:
     return f"{stat.st_ino}\t{stat.st_mtime_ns}\t{digest}"
 
 
-def record(workdir: Path, run: str) -> int:
-    marked = incomplete_outputs(workdir)
-    results = workdir / "results" / run
-    kept = 0
-    for path in sorted(results.rglob("*")):
-        relative = path.relative_to(workdir)
-        if not path.is_file() or relative.parts[2] in SKIPPED:
+def record(workdir: Path, store: str) -> int:
+    marked = incomplete_outputs(workdir)  # before the entries: see the docstring
+    root = workdir / store
+    entries = sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else []
+    finished = unfinished = files = 0
+    for entry in entries:
+        prefix = os.path.relpath(entry, workdir) + os.sep
+        if not (entry / SEAL).is_file() or any(m.startswith(prefix) for m in marked):
+            unfinished += 1
             continue
-        if str(relative) in marked:
-            continue
-        print(f"{relative}\t{fingerprint(path)}")
-        kept += 1
-    print(f"{kept} finished outputs, {len(marked)} marked incomplete", file=sys.stderr)
+        finished += 1
+        for path in sorted(entry.rglob("*")):
+            if path.is_file() and not path.is_symlink():
+                print(f"{path.relative_to(workdir)}\t{fingerprint(path)}")
+                files += 1
+    print(
+        f"{finished} finished entries ({files} files), {unfinished} unfinished"
+        f" ({len(marked)} outputs marked incomplete)",
+        file=sys.stderr,
+    )
     return 0
 
 

@@ -1,46 +1,70 @@
 #!/usr/bin/env bash
 # Live SLURM test: start a one-node SLURM cluster on this machine, run the
 # tiny test config through the SLURM profile (profiles/slurm) with two faults a cluster
-# user meets, and compare the results byte for byte with a local run of the same config.
+# user meets, compare the results byte for byte with a local run of the same config,
+# then check that a second run name reuses the first run's results on the cluster.
 #
-#   1. Snakemake killed (SIGKILL: a dropped ssh session, an OOM kill) while its jobs run.
+#   1. Snakemake killed (SIGKILL: a dropped ssh session, an OOM kill) while its jobs run,
+#      once 5 have finished and a job is writing into its store entry (not yet sealed).
 #      The test then does what docs/cluster.md tells a user: retypes the command (Snakemake
 #      refuses: the directory is locked, "--unlock"), waits until the killed run's jobs
 #      have left the queue, `--unlock`s, and reruns the same command.
 #   2. One job of that rerun cancelled by `scancel` while it runs (preemption, a lost
 #      node): the profile's `retries: 1` resubmits it and the rerun finishes.
+#   3. Reuse on the cluster: the same config under a second run name. Every job writes
+#      into the result store (results/.store/<rule>-<wildcards>-<key>/, key: the hash of
+#      its recipe; docs/store.md), so Snakemake finds every result the first runs
+#      computed and starts only the jobs whose recipe states the run: summary and
+#      article through sbatch, and the local job run_folder on the submitting host.
 #
-# Checked: every job of the local run ran through sbatch and COMPLETED exactly once in
-# SLURM (the jobs left running by the killed Snakemake count: the rerun keeps their
-# outputs), the one cancelled job excepted; Snakemake's error names the cancelled job and
-# its SLURM log; no output finished before the kill was rewritten by the rerun (inode,
-# time, SHA-256: .ci/output_snapshot.py); results/ identical to the local run. Each step
-# waits for a state it can see (a line of Snakemake's log, a job RUNNING in squeue, a
-# job's final state), polling with a time limit and a message naming what did not come.
+# Checked, runs 1 and 2: every computing job of the local run ran through sbatch and
+# COMPLETED exactly once in SLURM, counted per rule (the jobs left running by the killed
+# Snakemake count: the rerun keeps their results), the one cancelled job excepted; the
+# only jobs run on the submitting host are `run_folder` and `all` (Snakemake's
+# "localrule"); Snakemake's error names the cancelled job and its SLURM log; no store
+# entry finished before the kill (sealed, no output marked incomplete) was rewritten or
+# discarded by the rerun (inode, time, SHA-256: .ci/output_snapshot.py), and every entry
+# is sealed, none marked incomplete, and checks against its SHA256SUMS afterwards (the
+# entries the killed run's jobs were writing, finished by those jobs; the cancelled
+# job's, redone); the store holds the same entries as the local run's (same names,
+# hence same keys: both copies of the checkout come from one snapshot of its files)
+# with the same bytes (each entry's files, less its log and benchmark, which hold
+# times), and the run folder the same tables, figures, summary and article (less logs/,
+# benchmarks/ and the SHA256SUMS that lists them; its SHA256SUMS checks).
+# Run 3: the only jobs Snakemake starts are summary and article ("rule X:") and
+# run_folder ("localrule"); sacct counts exactly as many sbatch jobs as the former; no
+# file of the store changes and the only new entries are one summary and one article;
+# its run folder has the same bytes as run 2's (summary and article aside, which state
+# the run name), the same logs and benchmarks (copies of the same entries'), plain files,
+# and its SHA256SUMS checks.
+# Each step waits for a state it can see (a line of Snakemake's log, a job RUNNING in
+# squeue, a job's final state), polling with a time limit and a message naming what did
+# not come.
 #
 # Everything lives in a temporary folder (munged with its own key and socket, slurm.conf,
-# SLURM's state and logs) and no system service is used (no systemd, no cgroups:
-# proctrack/linuxproc, task/none, no accounting). One file outside it: the executor
-# plugin strips SLURM_* variables (SLURM_CONF too) from the jobs, so srun inside a job
-# reads the default /etc/slurm/slurm.conf; the test links it to its own while it runs
-# (and skips if the machine has one). On exit, whatever happens: the Snakemake processes
-# started here are stopped by their pid, SLURM's jobs cancelled (our cluster only), every
-# daemon started here stopped by its pid, any process still working in the temporary
-# folder killed, and the link removed. Where SLURM cannot be started (not root, packages
-# not installable, plugin missing) the test prints "slurm live test: SKIPPED: <reason>" and exits 0;
-# any failure once SLURM runs exits 1.
+# SLURM's state and logs, the checkout's copies with their result stores) and no system
+# service is used (no systemd, no cgroups: proctrack/linuxproc, task/none, no
+# accounting). One file outside it: the executor plugin strips SLURM_* variables
+# (SLURM_CONF too) from the jobs, so srun inside a job reads the default
+# /etc/slurm/slurm.conf; the test links it to its own while it runs (and skips if the
+# machine has one). On exit, whatever happens: the Snakemake processes started here are
+# stopped by their pid, SLURM's jobs cancelled (our cluster only), every daemon started
+# here stopped by its pid, any process still working in the temporary folder killed,
+# and the link removed. Where SLURM cannot be started (not root, packages not
+# installable, plugin missing) the test prints "slurm live test: SKIPPED: <reason>" and
+# exits 0; any failure once SLURM runs exits 1.
 #
 # Needs the project installed with the extra: pip install -e ".[test,slurm]".
-#   3. Reuse on the cluster: the same config under a second run name takes every result
-#      but the run's own summary and article from the store the first runs filled, before
-#      its first job: it submits exactly as many sbatch jobs as jobs that compute (counted
-#      by sacct from SLURM's job completion log), and gives the same bytes.
 # HERTZCHAIN_SLURM_KEEP=1 keeps the folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 CONFIG=tests/configs/tiny.yaml
 RUN=tiny # run_name of $CONFIG
+STORE=results/.store # the result store of each copy of the checkout (docs/store.md)
+# Each copy's own store: one elsewhere, shared by both copies, would let the SLURM run
+# take the local run's results and submit nothing.
+unset HERTZCHAIN_STORE HERTZCHAIN_STORE_GROUP
 
 skip() {
     echo "slurm live test: SKIPPED: $*"
@@ -246,21 +270,28 @@ wait_for 30 "slurmd (node idle)" node_idle
 say "SLURM up: $(sinfo -h -o '%P %D %c CPUs %m MB %T')"
 
 # ---- the same config, locally and through SLURM, in two copies of the checkout --------
-copy_checkout() { # copy_checkout DEST [CACHE_FROM]: the checkout's files; numba's cache
-    mkdir -p "$1"
-    if git -C "$ROOT" rev-parse --git-dir >/dev/null 2>&1; then
-        git -C "$ROOT" ls-files -z -co --exclude-standard | tar -C "$ROOT" --null -T - -cf - |
-            tar -C "$1" -xf -
-    else
-        tar -C "$ROOT" --exclude=./results --exclude=./.snakemake -cf - . | tar -C "$1" -xf -
-    fi
-    # numba's compiled kernels, from CACHE_FROM (a copy that ran) or the checkout (tar
-    # keeps the sources' times, which is what numba checks): saves compiling them in the
-    # jobs again, a minute or more.
-    (cd "${2:-$ROOT}" && find src -name '*.nbi' -o -name '*.nbc' | tar -cf - -T -) |
-        tar -C "$1" -xf -
+# One snapshot of the checkout's files, copied twice: a key hashes the code its job runs,
+# so both runs must run the same code even if the checkout is edited while this test
+# runs (seen: a source edited between two copies gave other keys, hence other entries).
+copy_tree() { # copy_tree FROM DEST: every file, with its time (numba checks the sources')
+    mkdir -p "$2"
+    tar -C "$1" -cf - . | tar -C "$2" -xf -
 }
-copy_checkout "$WORK/local"
+copy_numba_cache() { # copy_numba_cache FROM DEST: numba's compiled kernels
+    # Saves compiling them in the jobs again, a minute or more.
+    (cd "$1" && find src -name '*.nbi' -o -name '*.nbc' | tar -cf - -T -) | tar -C "$2" -xf -
+}
+mkdir -p "$WORK/checkout"
+if git -C "$ROOT" rev-parse --git-dir >/dev/null 2>&1; then
+    git -C "$ROOT" ls-files -z -co --exclude-standard |
+        (cd "$ROOT" && while IFS= read -r -d '' f; do [[ -e $f ]] && printf '%s\0' "$f"; done) |
+        tar -C "$ROOT" --null -T - -cf - | tar -C "$WORK/checkout" -xf -
+else
+    tar -C "$ROOT" --exclude=./results --exclude=./.snakemake -cf - . |
+        tar -C "$WORK/checkout" -xf -
+fi
+copy_numba_cache "$ROOT" "$WORK/checkout"
+copy_tree "$WORK/checkout" "$WORK/local"
 start=$SECONDS
 (cd "$WORK/local" && PYTHONPATH=$WORK/local/src${PYTHONPATH:+:$PYTHONPATH} snakemake --cores 2 --configfile "$CONFIG" \
     >"$WORK/local-run.log" 2>&1) || {
@@ -268,7 +299,8 @@ start=$SECONDS
     exit 1
 }
 say "local run: $((SECONDS - start)) s (load average $(load))"
-copy_checkout "$WORK/slurm" "$WORK/local"
+copy_tree "$WORK/checkout" "$WORK/slurm"
+copy_numba_cache "$WORK/local" "$WORK/slurm" # as compiled by the local run
 
 # The command a user types (README, docs/cluster.md), plus the settings of this test cluster only (a real
 # cluster has sacct and an account): squeue for job states, no account, first status
@@ -310,8 +342,16 @@ run_over() {
 job_state() { scontrol show job "$1" | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p'; }
 job_ended() { [[ ! $(job_state "$1") =~ ^(PENDING|RUNNING|CONFIGURING|COMPLETING|SUSPENDED)$ ]]; }
 started_run() { [[ -n $(run_id "$1") ]]; }
-mid_run() { # mid_run LOG ID N: N jobs finished and one RUNNING in SLURM
-    (($(finished_jobs "$1") >= $3)) && [[ -n $(running_jobs "$2") ]]
+unsealed_entries() { # the store's entries a job is writing, or left half-written
+    local entry
+    for entry in "$WORK/slurm/$STORE"/*/; do
+        [[ -d $entry && ! -e $entry/SHA256SUMS ]] && basename "$entry"
+    done
+    return 0
+}
+mid_run() { # mid_run LOG ID N: N jobs finished, one RUNNING in SLURM, an entry being written
+    (($(finished_jobs "$1") >= $3)) && [[ -n $(running_jobs "$2") ]] &&
+        [[ -n $(unsealed_entries) ]]
 }
 
 # ---- fault 1: Snakemake killed while its jobs run --------------------------------------
@@ -321,18 +361,25 @@ start_snakemake "$WORK/slurm-run-1.log"
 WATCH=$SNAKE
 wait_until 300 "the SLURM run ID in slurm-run-1.log" started_run "$WORK/slurm-run-1.log"
 RUN1=$(run_id "$WORK/slurm-run-1.log")
-wait_until 1200 "5 jobs finished and one RUNNING in SLURM (run 1, $RUN1)" \
+wait_until 1200 "5 jobs finished, one RUNNING in SLURM and a store entry being written (run 1, $RUN1)" \
     mid_run "$WORK/slurm-run-1.log" "$RUN1" 5
 kill -KILL "$SNAKE" || fail "Snakemake (pid $SNAKE) ended before it could be killed"
 WATCH=
 wait "$SNAKE" || true
-say "killed Snakemake (pid $SNAKE) after $(finished_jobs "$WORK/slurm-run-1.log") finished jobs;" \
-    "SLURM jobs of run 1 still queued or running: $(active_jobs -n "$RUN1" | sort -n | tr '\n' ' ')"
+FINISHED=$(finished_jobs "$WORK/slurm-run-1.log")
+say "killed Snakemake (pid $SNAKE) after $FINISHED finished jobs;" \
+    "SLURM jobs of run 1 still queued or running: $(active_jobs -n "$RUN1" | sort -n | tr '\n' ' ');" \
+    "store entries being written: $(unsealed_entries | tr '\n' ' ')"
 SNAKE=
-python "$ROOT/.ci/output_snapshot.py" record "$WORK/slurm" "$RUN" \
+# The store entries finished by now (the run folder is written by the run's last job,
+# so the store is all there is). Each job Snakemake logged as finished has one.
+python "$ROOT/.ci/output_snapshot.py" record "$WORK/slurm" "$STORE" \
     >"$WORK/finished-before-kill.tsv" 2>"$WORK/snapshot.err" ||
-    fail "could not record the finished outputs: $(cat "$WORK/snapshot.err")"
-say "before the kill: $(cat "$WORK/snapshot.err")"
+    fail "could not record the finished store entries: $(cat "$WORK/snapshot.err")"
+say "after the kill: $(cat "$WORK/snapshot.err")"
+ENTRIES_BEFORE=$(sed -n 's/^\([0-9]*\) finished entries.*/\1/p' "$WORK/snapshot.err")
+((ENTRIES_BEFORE >= FINISHED)) ||
+    fail "$ENTRIES_BEFORE finished store entries recorded, $FINISHED jobs finished before the kill"
 
 # What a user sees on retyping the command: the lock, and how to lift it.
 run_snakemake 300 "$WORK/slurm-run-locked.log"
@@ -385,82 +432,150 @@ SLURM_LOG=$(grep -o "results/slurm-logs/[^ ,]*/$CANCELLED\.log" "$LOG2" | head -
 grep -q '^Trying to restart job' "$LOG2" || fail "the cancelled job was not resubmitted"
 say "Snakemake: \"SLURM-job '$CANCELLED' failed, SLURM status is: 'CANCELLED'\", log $SLURM_LOG; resubmitted (retries: 1)"
 
-# ---- no output finished before the kill was recomputed -----------------------------------
+# ---- no result finished before the kill was recomputed; none left unfinished ---------
 if ! python "$ROOT/.ci/output_snapshot.py" check "$WORK/slurm" \
     "$WORK/finished-before-kill.tsv" >"$WORK/rewritten.txt"; then
-    fail "the rerun rewrote outputs finished before the kill: $(tr '\n' ' ' <"$WORK/rewritten.txt")"
+    fail "the rerun rewrote or discarded results finished before the kill: $(tr '\n' ' ' <"$WORK/rewritten.txt")"
 fi
-say "the $(wc -l <"$WORK/finished-before-kill.tsv") outputs finished before the kill are untouched (inode, time, SHA-256)"
+say "the $ENTRIES_BEFORE store entries finished before the kill are untouched" \
+    "($(wc -l <"$WORK/finished-before-kill.tsv") files: inode, time, SHA-256)"
+# What the killed run left running or half-written is finished now: every entry sealed
+# and checking against its SHA256SUMS (its outputs, and the inputs it read from other
+# entries, ../<entry>/<file>), no output still marked incomplete.
+python "$ROOT/.ci/output_snapshot.py" record "$WORK/slurm" "$STORE" \
+    >"$WORK/store-after-run-2.tsv" 2>"$WORK/snapshot.err" ||
+    fail "could not record the store after run 2: $(cat "$WORK/snapshot.err")"
+grep -q ' 0 unfinished (0 outputs marked incomplete)$' "$WORK/snapshot.err" ||
+    fail "after run 2, the store has unfinished entries: $(cat "$WORK/snapshot.err")"
+ENTRIES=0
+for entry in "$WORK/slurm/$STORE"/*/; do
+    (cd "$entry" && sha256sum -c --quiet --strict SHA256SUMS >/dev/null 2>&1) ||
+        fail "store entry $(basename "$entry") does not check against its SHA256SUMS"
+    ENTRIES=$((ENTRIES + 1))
+done
+say "after run 2: $(cat "$WORK/snapshot.err"); each checks against its SHA256SUMS"
 
-# ---- every job went through sbatch and COMPLETED once ----------------------------------
+# ---- every computing job went through sbatch and COMPLETED once ----------------------
 # Job ids from SLURM (job name: the run's SLURM run ID), not from Snakemake's log: a
 # Snakemake killed right after sbatch never printed "submitted with SLURM jobid" (seen:
-# the last two jobs of run 1).
-mapfile -t IDS < <(squeue --states=all -h -n "$RUN1,$RUN2" -o %i | sort -n)
-# Jobs of the local run (Snakemake logs each as "localrule <name>:"), less the target rule
-# `all`, which runs on the submitting host in the SLURM run too.
-LOCAL_JOBS=$(grep -E '^(local)?rule ' "$WORK/local-run.log" | grep -vc ' all:' || true)
+# the last two jobs of run 1). Each job's rule from its sbatch --comment
+# ("rule_<rule>_wildcards_<values>", set by the executor plugin).
+rule_of_comment() { sed -e 's/^rule_//' -e 's/_wildcards_.*//'; }
 say "SLURM job listing (squeue --states=all; NAME: the run's SLURM run ID):"
 printf '    %6s %-8s %-42s %-10s %4s %8s %8s\n' JOBID NAME "RULE (sbatch --comment)" STATE CPUS \
     MEMORY TIME
 squeue --states=all -h -n "$RUN1,$RUN2" -o '%.6i %.8j %.42k %.10T %.4C %.8m %.8M' |
     sort -n | sed 's/^/    /'
-[[ ${#IDS[@]} -gt 0 ]] || fail "no job went through sbatch"
+squeue --states=all -h -n "$RUN1,$RUN2" -o '%i|%T|%k' | sort -n >"$WORK/slurm-jobs.txt"
+[[ -s $WORK/slurm-jobs.txt ]] || fail "no job went through sbatch"
+SUBMITTED12=$(wc -l <"$WORK/slurm-jobs.txt")
 completed=0
-for id in "${IDS[@]}"; do
-    state=$(job_state "$id")
+: >"$WORK/slurm-completed-rules.txt"
+while IFS='|' read -r id state comment; do
     if [[ $state == COMPLETED ]]; then
         completed=$((completed + 1))
+        rule_of_comment <<<"$comment" >>"$WORK/slurm-completed-rules.txt"
     elif [[ $id != "$CANCELLED" ]]; then
-        fail "SLURM job $id is $state"
+        fail "SLURM job $id ($comment) is $state"
     fi
-done
-((completed == LOCAL_JOBS)) ||
-    fail "$completed SLURM jobs COMPLETED, $LOCAL_JOBS local jobs (a job ran twice, or not at all)"
-say "${#IDS[@]} jobs submitted with sbatch (ids ${IDS[0]}..${IDS[-1]}): $completed COMPLETED," \
-    "one per job of the local run, and the cancelled one"
+done <"$WORK/slurm-jobs.txt"
+# The jobs Snakemake ran on the submitting host ("localrule X:"): run_folder (a copy
+# from the store into the run folder) and the target rule all. Any other would be a
+# computing job run beside SLURM.
+LOCAL_RULES=$(cat "$WORK/slurm-run-1.log" "$WORK/slurm-run-2.log" |
+    sed -n 's/^localrule \([A-Za-z0-9_]*\):$/\1/p' | sort -u | tr '\n' ' ')
+[[ $LOCAL_RULES == "all run_folder " ]] ||
+    fail "SLURM runs 1 and 2 ran on the submitting host: ${LOCAL_RULES:-nothing} (expected: all run_folder)"
+# The local run logs every job as "localrule X:"; its jobs less those two are the ones
+# SLURM must have completed, once each: compared rule by rule.
+sed -n 's/^\(local\)\{0,1\}rule \([A-Za-z0-9_]*\):$/\2/p' "$WORK/local-run.log" |
+    grep -vxE 'all|run_folder' | sort | uniq -c >"$WORK/local-jobs-per-rule.txt"
+sort "$WORK/slurm-completed-rules.txt" | uniq -c >"$WORK/slurm-jobs-per-rule.txt"
+LOCAL_JOBS=$(awk '{n += $1} END {print n + 0}' "$WORK/local-jobs-per-rule.txt")
+diff "$WORK/local-jobs-per-rule.txt" "$WORK/slurm-jobs-per-rule.txt" >"$WORK/jobs-per-rule.diff" ||
+    fail "$completed SLURM jobs COMPLETED, $LOCAL_JOBS computing jobs in the local run; per rule" \
+        "(< local run, > SLURM, a job ran twice or not at all): $(tr '\n' ' ' <"$WORK/jobs-per-rule.diff")"
+mapfile -t IDS < <(cut -d '|' -f 1 "$WORK/slurm-jobs.txt")
+say "$SUBMITTED12 jobs submitted with sbatch (ids ${IDS[0]}..${IDS[-1]}): $completed COMPLETED," \
+    "one per computing job of the local run (rule by rule), and the cancelled one;" \
+    "on the submitting host: all, run_folder"
 
 # ---- same bytes -----------------------------------------------------------------------
-# .snakemake_timestamp is Snakemake's marker in a directory output (the virtual
-# experiment's raw/N<N>), a time; SHA256SUMS lists logs/ too.
+# The run folders: tables, figures, summary, article. Not logs/ or benchmarks/ (times),
+# nor the SHA256SUMS that lists them; .snakemake_timestamp is Snakemake's marker in a
+# directory output (the virtual experiment's raw/), a time.
 compare() { # compare RUN_A RUN_B [EXCLUDE...]: the results of two run folders
     diff -r --brief --exclude=logs --exclude=benchmarks --exclude=.snakemake_timestamp \
         --exclude=SHA256SUMS "${@:3}" "$1" "$2"
 }
 compare "$WORK/local/results/$RUN" "$WORK/slurm/results/$RUN" ||
-    fail "results differ between the local and the SLURM run"
+    fail "results/$RUN differs between the local and the SLURM run"
 COUNT=$(cd "$WORK/slurm/results/$RUN" && find . -type f -not -path './logs/*' \
-    -not -path './benchmarks/*' | wc -l)
-say "results/$RUN identical to the local run, byte for byte ($COUNT files; logs/ and benchmarks/ excluded)"
+    -not -path './benchmarks/*' -not -name SHA256SUMS | wc -l)
+(cd "$WORK/slurm/results/$RUN" && sha256sum -c --quiet --strict SHA256SUMS) ||
+    fail "results/$RUN/SHA256SUMS does not check"
+# The store: the same entries (their names carry the keys, which do not depend on the
+# executor), each with the same files and bytes, less the job's log and benchmark file.
+diff <(ls "$WORK/local/$STORE") <(ls "$WORK/slurm/$STORE") >"$WORK/entries.diff" ||
+    fail "the store's entries differ between the local and the SLURM run (< local, > SLURM):" \
+        "$(tr '\n' ' ' <"$WORK/entries.diff")"
+diff -r --brief --exclude=log --exclude=benchmark.tsv --exclude=.snakemake_timestamp \
+    "$WORK/local/$STORE" "$WORK/slurm/$STORE" ||
+    fail "the stored results differ between the local and the SLURM run"
+STORED=$(cd "$WORK/slurm/$STORE" && find . -type f -not -name log -not -name benchmark.tsv \
+    -not -name .snakemake_timestamp | wc -l)
+say "results/$RUN identical to the local run, byte for byte ($COUNT files; logs/, benchmarks/" \
+    "and SHA256SUMS excluded; SHA256SUMS checks); $STORE: the same $ENTRIES entries" \
+    "(same keys), $STORED files identical (logs and benchmark files excluded)"
 
-# ---- reuse on the cluster: a second run name takes what the first computed ----------
-# Runs 1 and 2 stored their results (results/.store, on the file system the nodes share);
-# the same config under another name takes them into its run folder before its first job,
-# on the login node, and submits only the jobs stating the run (summary, summary_md,
-# article): sacct counts its sbatch jobs.
+# ---- reuse on the cluster: a second run name computes only what states the run ---------
+# Runs 1 and 2 filled the store (results/.store, on the file system the nodes share); the
+# same config under another name finds every result whose recipe does not state the run,
+# so Snakemake starts only summary and article (sbatch) and run_folder (local). sacct
+# counts its sbatch jobs from SLURM's job completion log; the store is fingerprinted
+# before it, and nothing in it may change.
 AGAIN=${RUN}_again
+cp "$WORK/store-after-run-2.tsv" "$WORK/store-before-run-3.tsv"
 start=$SECONDS
 run_snakemake 1800 "$WORK/slurm-run-3.log" --config "run_name=$AGAIN"
 [[ $STATUS -eq 0 ]] || fail "SLURM run 3 (run_name $AGAIN) failed (status $STATUS)"
-FORECAST=$(grep -o '[0-9]* of [0-9]* jobs take a stored result, [0-9]* compute' \
-    "$WORK/slurm-run-3.log" | head -n 1)
-COMPUTE=$(sed -n 's/.* \([0-9]*\) compute$/\1/p' <<<"$FORECAST")
-[[ $COMPUTE -eq 3 ]] || fail "run 3's first line: '${FORECAST:-none}', not 3 jobs to compute"
-RUN3=$(run_id "$WORK/slurm-run-3.log")
+LOG3=$WORK/slurm-run-3.log
+RULES3=$(sed -n 's/^rule \([A-Za-z0-9_]*\):$/\1/p' "$LOG3" | sort | tr '\n' ' ')
+LOCAL3=$(sed -n 's/^localrule \([A-Za-z0-9_]*\):$/\1/p' "$LOG3" | sort | tr '\n' ' ')
+[[ $RULES3 == "article summary " && $LOCAL3 == "all run_folder " ]] ||
+    fail "run 3 started the jobs of [${RULES3% }] through SLURM and [${LOCAL3% }] locally;" \
+        "expected [article summary] and [all run_folder]"
+COMPUTE=$(grep -c '^rule [A-Za-z0-9_]*:$' "$LOG3")
+RUN3=$(run_id "$LOG3")
 SUBMITTED=$(sacct --completion -n -P -o JobName,JobID | awk -F'|' -v run="$RUN3" \
     '$1 == run' | wc -l)
-say "run 3: sacct counts $SUBMITTED sbatch jobs (SLURM run ID $RUN3); $COMPUTE jobs compute"
-[[ $SUBMITTED -eq $COMPUTE ]] || fail "run 3 submitted $SUBMITTED sbatch jobs, $COMPUTE compute"
+say "run 3: sacct counts $SUBMITTED sbatch jobs (SLURM run ID $RUN3); Snakemake started" \
+    "$COMPUTE non-local jobs (${RULES3% }) and ${LOCAL3% } locally"
+[[ $SUBMITTED -eq $COMPUTE ]] || fail "run 3 submitted $SUBMITTED sbatch jobs, Snakemake started $COMPUTE"
+python "$ROOT/.ci/output_snapshot.py" check "$WORK/slurm" "$WORK/store-before-run-3.tsv" \
+    >"$WORK/rewritten-3.txt" ||
+    fail "run 3 rewrote or discarded stored results: $(tr '\n' ' ' <"$WORK/rewritten-3.txt")"
+NEW=$(comm -13 <(cut -f 1 "$WORK/store-before-run-3.tsv" | cut -d / -f 3 | sort -u) \
+    <(ls "$WORK/slurm/$STORE" | sort) | sed 's/-[0-9a-f]\{32\}$//' | sort | tr '\n' ' ')
+[[ $NEW == "article summary " ]] ||
+    fail "run 3 added the store entries [${NEW% }]; expected one article and one summary"
 AGAIN_DIR=$WORK/slurm/results/$AGAIN
-for log in "$AGAIN_DIR"/logs/simulate/*.log "$AGAIN_DIR"/logs/experiment/virtual_*.log; do
-    grep -q '^taken from the store: ' "$log" || fail "run 3 computed ${log#"$AGAIN_DIR"/}"
-done
 compare "$WORK/slurm/results/$RUN" "$AGAIN_DIR" --exclude=summary.json \
     --exclude=summary.md --exclude=article.pdf ||
     fail "run 3's results differ from those it reused"
-(cd "$AGAIN_DIR" && sha256sum -c --quiet SHA256SUMS) || fail "run 3's SHA256SUMS does not check"
+# Its logs and benchmarks are copies of the same entries' as run 2's: the same bytes,
+# less those of the jobs it ran.
+diff -r --brief --exclude=summary.log --exclude=article.log --exclude=run_folder.log \
+    --exclude=summary.tsv --exclude=article.tsv \
+    "$WORK/slurm/results/$RUN/logs" "$AGAIN_DIR/logs" ||
+    fail "run 3's logs/ differ from run 2's (a job ran again)"
+diff -r --brief --exclude=summary.tsv --exclude=article.tsv \
+    "$WORK/slurm/results/$RUN/benchmarks" "$AGAIN_DIR/benchmarks" ||
+    fail "run 3's benchmarks/ differ from run 2's (a job ran again)"
+(cd "$AGAIN_DIR" && sha256sum -c --quiet --strict SHA256SUMS) || fail "run 3's SHA256SUMS does not check"
 [[ -z $(find "$AGAIN_DIR" -type l) ]] || fail "run 3's folder holds links"
-say "SLURM run 3 (run_name $AGAIN): $FORECAST; $SUBMITTED sbatch jobs; no simulation" \
-    "computed; results identical to run 2's, plain files, SHA256SUMS checks" \
-    "($((SECONDS - start)) s)"
+say "SLURM run 3 (run_name $AGAIN): $SUBMITTED sbatch jobs (${RULES3% }), ${LOCAL3% } local;" \
+    "the store untouched but for one new summary and one new article entry; results," \
+    "logs and benchmarks identical to run 2's, plain files, SHA256SUMS checks" \
+    "($((SECONDS - start)) s, load average $(load))"
 say "PASSED"
