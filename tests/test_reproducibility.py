@@ -4,27 +4,37 @@ interruption, and numerical guard rails.
 Workflow tests (marked ``workflow``) take the tiny run (tests/configs/tiny.yaml, every
 rule), which conftest.py's ``tiny_run`` builds once per test session with 2 cores in a
 temporary copy of the checkout (Snakefile, workflow/, config.yaml; the library copied
-and put on ``PYTHONPATH``) for test_workflow.py too, then, each in its own copy of that
-first build (so that they may run at the same time, in pytest-xdist's workers),
+and put on ``PYTHONPATH``) for test_workflow.py too. Every computing job writes into
+its folder of the result store (``results/.store/<rule>-<label>-<key>``) and seals it
+(``SHA256SUMS``, outputs read-only); the run folder ``results/tiny/`` holds copies of
+the published files. Then, each in its own copy of that first build (so that they may
+run at the same time, in pytest-xdist's workers),
 
-* (a second build of every rule on 1 core under another ``PYTHONHASHSEED``, which
-  requires the same bytes in every file of ``results/tiny/`` but ``logs/`` and
-  ``benchmarks/``, summary.md and the article included, and a reused result against a
-  recomputed one, is test_workflow.py's test_a_recomputed_run_gives_the_stored_bytes;
-  the interrupted rebuilds below run on 2 cores and require those bytes again);
-* look for the temporary directory, the checkout's path and today's date in the files;
-* interrupt a ``--forceall`` rebuild as soon as a simulation output is being written
-  (Ctrl-C), then a forced rebuild of the tables (and all after them) as soon as a
-  table is being written (a crash: SIGKILL), check after each that every file under
-  its final name is still a complete one, run what the user must type, and require
-  the same bytes again; the same with SIGTERM to Snakemake, then to the process group
-  (marked ``slow``).
+* (a second build of every rule on 1 core under another ``PYTHONHASHSEED``, the same
+  bytes in every file of ``results/tiny/`` but ``logs/`` and ``benchmarks/``, is
+  test_workflow.py's; the interrupted rebuilds below run on 2 cores and require the
+  first build's bytes again, in the run folder and in every entry of the store);
+* look for the temporary directory, the checkout's path and today's date in the run
+  folder's files and in every stored result (the intermediate files, traces and raw
+  shots, are in the store only);
+* interrupt a rebuild of the simulations and everything after them (their entries
+  removed, as a change of the simulation code gives new ones; the jobs that do not
+  read them stay stored) as soon as a simulation output is being written (Ctrl-C),
+  then a forced rebuild of the tables (``--forcerun pulses``: pulses and every job
+  after it write their entries again) as soon as a table is being written (a crash:
+  SIGKILL); check after each that every file under its final name, in the run folder
+  and in the store, is a complete one, run what the user must type, and require the
+  same bytes again; then ask for the entries that a killed job left unsealed, and
+  require the first build's store, entry for entry; the same with SIGTERM to
+  Snakemake, then to the process group (marked ``slow``).
 
-What Snakemake 9 (measured with 9.27) does when interrupted, and what to type next:
+What Snakemake 9 (measured with 9.27, the default profile) does when interrupted, and
+what to type next:
 
-* SIGINT to the process group (Ctrl-C): kills the running jobs and exits 1; outputs a
-  killed job had already written stay, marked incomplete (.snakemake/incomplete), and
-  a plain rerun stops with IncompleteFilesException. Next:
+* SIGINT to the process group (Ctrl-C): kills the running jobs, deletes what they had
+  written and exits 1; the outputs of every job running at the signal are marked
+  incomplete (.snakemake/incomplete), also those of a job that had just sealed its
+  entry, and a plain rerun then stops with IncompleteFilesException. Next:
   ``snakemake --cores 2 --rerun-incomplete``.
 * SIGTERM to Snakemake alone (``kill PID``): graceful; it starts no new job, lets the
   running ones finish and exits 1. Next: ``snakemake --cores 2``.
@@ -32,15 +42,18 @@ What Snakemake 9 (measured with 9.27) does when interrupted, and what to type ne
   die, Snakemake deletes their outputs and exits 1. Next: ``snakemake --cores 2``.
 * SIGKILL to the process group (a crash, the OOM killer; a power loss is alike):
   nothing is cleaned up; the killed jobs' outputs are marked incomplete and the lock
-  stays in .snakemake/locks, so a rerun stops with IncompleteFilesException and, with
-  ``--rerun-incomplete``, with LockException. Next: ``snakemake --unlock``, then
-  ``snakemake --cores 2 --rerun-incomplete``.
+  stays in .snakemake/locks, so a rerun stops with LockException (and, once unlocked,
+  with IncompleteFilesException where a killed job's output is on disk). Next:
+  ``snakemake --unlock``, then ``snakemake --cores 2 --rerun-incomplete``.
 
 ``--rerun-incomplete`` is harmless when nothing is incomplete, so after any interruption
 ``snakemake --cores 2 --rerun-incomplete`` (after ``--unlock`` if Snakemake says the
 directory is locked) is the one command to remember. A file under its final name is
 always complete (atomic writes); a job killed by SIGKILL may leave a hidden temporary
-file (``.<name>.<random>``) beside its output, which nothing reads.
+file (``.<name>.<random>``) beside its output, which nothing reads. A killed job's
+entry is left unsealed (no ``SHA256SUMS``, one of its outputs: Snakemake sees it
+missing) and is computed anew by the next run that needs it; a run whose results are
+all in place (its run folder complete) needs none and leaves it so.
 
 Unit tests: failing writes leave nothing under the final name; every workflow script
 writes through the atomic writers; the integrator's bytes do not depend on the thread
@@ -82,6 +95,7 @@ from chain.analysis.ssw import ssw_fit_table, ssw_table
 from chain.errors import ParameterError
 from chain.physics.integrator import IntegrationError
 from chain.physics.theory import cos6_pulse
+from chain.pipeline.run.entries import ENTRY, SUMS, discard, file_digest, files_under
 from chain.traces import (
     META_COLUMNS,
     sensor_column,
@@ -97,6 +111,9 @@ SNAKEMAKE = [sys.executable, "-m", "snakemake", "--configfile", str(CONFIG)]
 #: Top-level entries of results/<run>/ that legitimately hold times: not compared
 #: (SHA256SUMS lists the logs' digests; it must check, test_interrupted_rebuild...).
 TIMED = ("logs", "benchmarks", "report.html", "SHA256SUMS")
+#: The files of a store entry that are not results: the job's log and benchmark (times),
+#: and the seal, compared whole (:func:`assert_store_holds_the_first_build`).
+NOT_STORED_RESULTS = ("log", "benchmark.tsv", SUMS)
 #: Longest a Snakemake call may take, s: a guard against a hang, far above a build's
 #: minutes on a machine shared with other workers (pytest-xdist) or other work.
 TIMEOUT = 1800
@@ -116,10 +133,15 @@ class Workspace:
     def out(self) -> Path:
         return self.work / "results" / RUN
 
+    @property
+    def store(self) -> Path:
+        return self.work / "results" / ".store"
+
 
 def copy_workspace(ws: Workspace, base: Path, env_of_library) -> Workspace:
-    """A copy of ``ws`` in ``base``: the checkout with its results, Snakemake's records
-    and the library with its compiled kernels; copy2 keeps the files' times."""
+    """A copy of ``ws`` in ``base``: the checkout with its results and store, Snakemake's
+    records and the library with its compiled kernels; copy2 keeps the files' times
+    (and the stored outputs' read-only modes)."""
     work = base / "work"
     shutil.copytree(ws.work, work, symlinks=True, copy_function=shutil.copy2)
     return Workspace(base, work, env_of_library(work / "src"), ws.reference)
@@ -130,6 +152,7 @@ def snakemake(ws: Workspace, *args, env: dict | None = None) -> subprocess.Compl
         [*SNAKEMAKE, *args],
         cwd=ws.work,
         env=ws.env if env is None else env,
+        stdin=subprocess.DEVNULL,
         capture_output=True,
         text=True,
         timeout=TIMEOUT,
@@ -156,8 +179,12 @@ def result_files(out: Path) -> list[Path]:
     return files
 
 
-def temporary_files(out: Path) -> set[str]:
-    return {str(p.relative_to(out)) for p in out.rglob(".*") if is_temporary(p.relative_to(out))}
+def temporary_files(folder: Path) -> set[str]:
+    return {
+        str(p.relative_to(folder))
+        for p in folder.rglob(".*")
+        if is_temporary(p.relative_to(folder))
+    }
 
 
 def digest(out: Path) -> dict[str, str]:
@@ -184,54 +211,116 @@ def first_difference(a: Path, b: Path) -> str:
     return f" ({len(old)} -> {len(new)} lines)"
 
 
-#: Folders of intermediate files (consumed by one rule, kept for inspection): after an
-#: interruption Snakemake deletes those of the jobs it killed and does not remake them
-#: while everything downstream is complete and up to date (c_sensitivity/: the every-
-#: estimator table that rule c_sensitivity_table reads, when the interruption hits the
-#: C-sensitivity job).
-INTERMEDIATES = ("simulation/", "experiment/", "ablation/", "c_sensitivity/")
-
-
-def assert_same_bytes(
-    ws: Workspace, expected: dict, what: str, may_be_missing: tuple[str, ...] = ()
-) -> None:
+def assert_same_bytes(ws: Workspace, expected: dict, what: str) -> None:
     diffs = differences(expected, digest(ws.out), ws.reference, ws.out)
-    diffs = [d for d in diffs if not d.startswith(tuple(f"missing: {p}" for p in may_be_missing))]
     assert not diffs, f"{what}: {len(diffs)} file(s) differ from the first build:\n" + "\n".join(
         diffs
     )
 
 
+# ---- the result store ----------------------------------------------------------------
+
+
+def entries(store: Path) -> dict[str, Path]:
+    """The store's entries (job folders), by name."""
+    return {p.name: p for p in sorted(store.iterdir()) if ENTRY.match(p.name)}
+
+
+def seals(store: Path) -> dict[str, str]:
+    """Entry name -> the text of its SHA256SUMS, for the sealed entries."""
+    return {
+        name: (entry / SUMS).read_text()
+        for name, entry in entries(store).items()
+        if (entry / SUMS).is_file()
+    }
+
+
+def listed_outputs(seal: str) -> dict[str, str]:
+    """An entry's outputs (path in it -> SHA-256) as its SHA256SUMS lists them (the
+    inputs it read, ``../<entry>/<file>``, left out)."""
+    listed = {}
+    for line in seal.splitlines():
+        sha, _, name = line.partition("  ")
+        if not name.startswith("../"):
+            listed[name] = sha
+    return listed
+
+
+def store_problems(store: Path, reference: dict[str, str]) -> list[str]:
+    """Where the store differs from the first build's (``reference``: its seals): an
+    entry it did not have, a file under its final name that is not the first build's
+    (a partial one), a seal of other content. Entries missing, or unsealed, are not
+    problems here."""
+    problems = []
+    for name, entry in entries(store).items():
+        if name not in reference:
+            problems.append(f"{name}: not an entry of the first build")
+            continue
+        listed = listed_outputs(reference[name])
+        for file in files_under(entry):
+            if file in NOT_STORED_RESULTS:
+                continue
+            if listed.get(file) != file_digest(entry / file):
+                problems.append(f"{name}/{file}: not the first build's bytes")
+        if (entry / SUMS).is_file() and (entry / SUMS).read_text() != reference[name]:
+            problems.append(f"{name}/{SUMS}: not the first build's")
+    return problems
+
+
+def downstream(store: Path, rules: tuple[str, ...]) -> list[Path]:
+    """The entries of ``rules`` and of every job that read them, at any remove, as the
+    seals list what each job read."""
+    found = {name: entry for name, entry in entries(store).items()
+             if ENTRY.match(name)["rule"] in rules}  # fmt: skip
+    read = {
+        name: {
+            line.split("  ", 1)[1].split("/")[1] for line in seal.splitlines() if "  ../" in line
+        }
+        for name, seal in seals(store).items()
+    }
+    while more := {name for name, inputs in read.items() if inputs & set(found)} - set(found):
+        found.update({name: store / name for name in more})
+    return sorted(found.values())
+
+
 @pytest.fixture(scope="session")
 def built(tiny_run, built_once, env_of_library):
     """Run 1: the tiny run (conftest.py's ``tiny_run``, test_workflow.py's too), built
-    from nothing with --cores 2 once per test session (a second build of every rule on
-    1 core must give the same bytes, summary.md and the article included:
-    test_workflow.py's test_a_recomputed_run_gives_the_stored_bytes);
-    (workspace, digest). A copy of its results is kept in <tiny-reference>/tiny, the
-    digest's source and the failure messages' reference. Tests that build again do so in
-    a copy (:func:`rebuilt`)."""
+    from nothing with --cores 2 once per test session; (workspace, digest of its run
+    folder, seals of its store). A copy of its run folder is kept in
+    <tiny-reference>/tiny, the digest's source and the failure messages' reference, and
+    of its entries' SHA256SUMS in <tiny-reference>/store. Tests that build again do so
+    in a copy (:func:`rebuilt`)."""
 
     def keep(base: Path) -> None:
         shutil.copytree(
             tiny_run / "results" / RUN, base / RUN, ignore=shutil.ignore_patterns(*TIMED)
         )
+        for name, seal in seals(tiny_run / "results" / ".store").items():
+            (base / "store" / name).mkdir(parents=True)
+            (base / "store" / name / SUMS).write_text(seal)
 
-    reference = built_once("tiny-reference", keep) / RUN
-    ws = Workspace(tiny_run.parent, tiny_run, env_of_library(tiny_run / "src"), reference)
+    kept = built_once("tiny-reference", keep)
+    ws = Workspace(tiny_run.parent, tiny_run, env_of_library(tiny_run / "src"), kept / RUN)
     expected = digest(ws.reference)
+    stored = {entry.name: (entry / SUMS).read_text() for entry in (kept / "store").iterdir()}
     assert expected == digest(ws.out)
+    assert stored == seals(ws.store) and not store_problems(ws.store, stored)
     assert any(f.startswith("figures/") and f.endswith(".pdf") for f in expected), expected
     assert "summary.json" in expected and "tables/delay_fits.csv" in expected, expected
-    assert any(f.startswith("experiment/raw/") for f in expected), "no virtual experiment ran"
-    return ws, expected
+    # Intermediate files are in the store only: the virtual experiment's raw shots.
+    raw = [n for n in stored if n.startswith("virtual_experiment-")]
+    assert raw and all("raw/shot_0001.csv" in listed_outputs(stored[n]) for n in raw), raw
+    assert not any(f.startswith(("experiment/raw/", "simulation/")) for f in expected)
+    return ws, expected, stored
 
 
 @pytest.fixture
 def rebuilt(built, tmp_path, env_of_library):
-    """(a copy of run 1's workspace, run 1's digest), for a test that builds again."""
-    ws, expected = built
-    return copy_workspace(ws, tmp_path, env_of_library), expected
+    """(a copy of run 1's workspace, run 1's digest, run 1's seals), for a test that
+    builds again."""
+    ws, expected, stored = built
+    return copy_workspace(ws, tmp_path, env_of_library), expected, stored
 
 
 # ---- part 1: same bytes --------------------------------------------------------------
@@ -248,21 +337,26 @@ def pdf_streams(data: bytes):
 @pytest.mark.workflow
 def test_outputs_hold_no_path_and_no_date(built):
     """No absolute path (temporary directory, checkout, home) and no date of the build
-    in any output, PDF streams inflated; no date or software field in PDF and PNG."""
-    ws, expected = built
+    in any output of the run folder or of the store (every stored result, the
+    intermediate traces and raw shots included), PDF streams inflated; no date or
+    software field in PDF and PNG."""
+    ws, expected, stored = built
     today = time.strftime("%Y-%m-%d").encode()
     forbidden = [str(ws.base).encode(), str(ROOT).encode(), today, b"D:" + today.replace(b"-", b"")]
     home = os.path.expanduser("~")
     if len(home) > 1:
         forbidden.append(home.encode() + b"/")
+    files = [ws.out / name for name in expected]
+    files += [ws.store / e / f for e, seal in stored.items() for f in listed_outputs(seal)]
+    assert len(files) > len(expected)
     found = []
-    for name in expected:
-        data = (ws.out / name).read_bytes()
-        texts = [data, *pdf_streams(data)] if name.endswith(".pdf") else [data]
+    for path in files:
+        name, data = path.relative_to(ws.work), path.read_bytes()
+        texts = [data, *pdf_streams(data)] if path.suffix == ".pdf" else [data]
         found += [f"{name}: {word!r}" for word in forbidden if any(word in t for t in texts)]
-        if name.endswith(".pdf"):
+        if path.suffix == ".pdf":
             found += [f"{name}: {k!r}" for k in (b"/CreationDate", b"/ModDate") if k in data]
-        if name.endswith(".png"):
+        if path.suffix == ".png":
             found += [f"{name}: {k!r} chunk" for k in (b"tIME", b"Software") if k in data]
     assert not found, "\n".join(found)
 
@@ -271,7 +365,7 @@ def test_outputs_hold_no_path_and_no_date(built):
 def test_no_nan_passes_quietly_into_the_tables(built):
     """Every ``ok`` row carries finite numbers and every flagged row a reason; a fit with
     enough points is finite; summary.json is strict JSON (NaN written as null)."""
-    ws, _ = built
+    ws, _, _ = built
     tables = ws.out / "tables"
     checks = {
         "pulses": ["F_m_N", "T_s", "tau_s"],
@@ -308,14 +402,6 @@ INTERRUPTIONS = {
     "SIGKILL-group": (signal.SIGKILL, True),
 }
 
-#: The rules that write results/<run>/tables/ in the tiny run, with or without LAMMPS:
-#: the second interruption's forced rebuild (``--forcerun``: them and every job after
-#: them).
-TABLE_RULES = (
-    "pulses", "delays", "delay_fits", "ssw", "ssw_fits", "ssw_speed", "c_sensitivity_table",
-    "ablation_table", "ssw_mechanisms",
-)  # fmt: skip
-
 #: What the user types after each interruption (the module docstring says why).
 AFTERWARDS = {
     "SIGINT-group": [["--cores", "2", "--rerun-incomplete"]],
@@ -325,18 +411,20 @@ AFTERWARDS = {
 }
 
 
-def written_since(folder: Path, since_ns: int) -> bool:
-    """A file of ``folder``, under its final or its temporary name, written since then."""
-    try:
-        entries = list(folder.iterdir())
-    except FileNotFoundError:
-        return False
-    for entry in entries:
+def written_since(folders: list[Path], since_ns: int) -> bool:
+    """A file of one of ``folders``, under its final or its temporary name, written
+    since then."""
+    for folder in folders:
         try:
-            if entry.stat().st_mtime_ns >= since_ns:
-                return True
-        except FileNotFoundError:  # renamed or deleted between listing and stat
+            files = list(folder.iterdir())
+        except FileNotFoundError:
             continue
+        for entry in files:
+            try:
+                if entry.stat().st_mtime_ns >= since_ns:
+                    return True
+            except FileNotFoundError:  # renamed or deleted between listing and stat
+                continue
     return False
 
 
@@ -359,13 +447,16 @@ def default_signal_handling() -> None:
         signal.signal(signum, signal.SIG_DFL)
 
 
-def interrupted_run(ws: Workspace, expected: dict, args, watched: str, how: str) -> None:
+def interrupted_run(
+    ws: Workspace, expected: dict, stored: dict, args, watched: str, how: str
+) -> None:
     """Run Snakemake with ``args`` in its own session, interrupt it as ``how`` as soon
-    as a file of results/<run>/``watched`` is being written, and wait until it and
-    every job it started have ended; it must have failed, and every file under its
-    final name must still be a complete one (the same bytes as run 1, or absent)."""
+    as a file of a store folder ``watched`` (a glob under results/.store) is being
+    written, and wait until it and every job it started have ended; it must have
+    failed, and every file under its final name, in the run folder and in the store,
+    must still be a complete one (the same bytes as run 1, or absent)."""
     signum, whole_group = INTERRUPTIONS[how]
-    before = temporary_files(ws.out)
+    before = temporary_files(ws.work / "results")
     log = ws.base / f"interrupted-{how}.log"
     start = time.time_ns()
     with log.open("w") as stream:
@@ -373,6 +464,7 @@ def interrupted_run(ws: Workspace, expected: dict, args, watched: str, how: str)
             [*SNAKEMAKE, *args],
             cwd=ws.work,
             env=ws.env,
+            stdin=subprocess.DEVNULL,
             stdout=stream,
             stderr=subprocess.STDOUT,
             start_new_session=True,
@@ -382,7 +474,7 @@ def interrupted_run(ws: Workspace, expected: dict, args, watched: str, how: str)
         )
     try:
         deadline = time.monotonic() + TIMEOUT
-        while process.poll() is None and not written_since(ws.out / watched, start):
+        while process.poll() is None and not written_since(list(ws.store.glob(watched)), start):
             assert time.monotonic() < deadline, f"nothing written to {watched}/"
             time.sleep(0.02)
         assert process.poll() is None, f"the run ended before it could be interrupted ({how})"
@@ -404,12 +496,14 @@ def interrupted_run(ws: Workspace, expected: dict, args, watched: str, how: str)
 
     partial = [f for f, h in digest(ws.out).items() if expected.get(f) != h]
     assert not partial, f"incomplete files under their final names after {how}: {partial}"
+    problems = store_problems(ws.store, stored)
+    assert not problems, f"incomplete stored files after {how}:\n" + "\n".join(problems)
     if signum != signal.SIGKILL:  # only SIGKILL gives a job no chance to clean up
-        left = temporary_files(ws.out) - before
+        left = temporary_files(ws.work / "results") - before
         assert not left, f"temporary files left after {how}: {left}"
 
 
-def resume(ws: Workspace, expected: dict, how: str) -> None:
+def resume(ws: Workspace, how: str) -> None:
     """Type what the user must type after ``how``; every command must succeed."""
     commands = AFTERWARDS[how]
     if how == "SIGKILL-group":
@@ -423,6 +517,13 @@ def resume(ws: Workspace, expected: dict, how: str) -> None:
         assert result.returncode == 0, f"snakemake {' '.join(command)}:\n{tail(result)}"
 
 
+def assert_store_holds_the_first_build(ws: Workspace, stored: dict, what: str) -> None:
+    problems = store_problems(ws.store, stored)
+    assert not problems, f"{what}: the store differs from the first build's:\n" + "\n".join(
+        problems
+    )
+
+
 @pytest.mark.workflow
 @pytest.mark.parametrize(
     ("first", "second"),
@@ -431,53 +532,64 @@ def resume(ws: Workspace, expected: dict, how: str) -> None:
         pytest.param(
             "SIGTERM-snakemake",
             "SIGTERM-group",
-            marks=[pytest.mark.slow, pytest.mark.heavy(cpu_s=10)],
+            marks=[pytest.mark.slow, pytest.mark.heavy(cpu_s=55)],
         ),
     ],
     ids=["ctrl-c-then-crash", "sigterm-snakemake-then-group"],
 )
 def test_interrupted_rebuild_resumes_to_the_same_bytes(rebuilt, first, second):
-    """A forced rebuild interrupted (``first``) while the simulations are being written,
-    then the user's command; a forced rebuild interrupted (``second``) while the tables
-    are being written, then the user's command: the same bytes as an uninterrupted
-    build, and after each interruption every file under its final name is a complete
-    one. (Each interruption hits a forced rebuild of the jobs that write the watched
-    folder, so that the run cannot end before the watched files are written, whatever
-    the machine's speed: the first a full one, the second one of the tables and
-    everything after them, :data:`TABLE_RULES`; a full one would compute every
-    simulation again before the first table, and the user's command then every table
-    and figure after them, which the first interruption already covers.)"""
-    ws, expected = rebuilt
-    interrupted_run(ws, expected, ["--forceall", "--cores", "2"], "simulation", first)
-    resume(ws, expected, first)
-    # Snakemake deletes the outputs of the jobs it killed; the rerun does not remake
-    # intermediate files whose downstream results are complete (as for temp() files),
-    # so the simulation traces and raw virtual-experiment files may be absent until a
-    # later change needs them. Every result that is there has the right bytes.
-    assert_same_bytes(
-        ws,
-        expected,
-        f"interrupted ({first}) and resumed",
-        may_be_missing=INTERMEDIATES,
-    )
+    """A rebuild of the simulations and every job after them (their entries and the run
+    folder removed, as a change of the simulation code leaves them to compute)
+    interrupted (``first``) while the simulations are being written, then the user's
+    command; a forced rebuild of the tables (``--forcerun pulses``: pulses and every job
+    after it write their entries again) interrupted (``second``) while a table is being
+    written, then the user's command: the same bytes as an uninterrupted build, in the
+    run folder and in every entry of the store, and after each interruption every file
+    under its final name is a complete one. Each interruption hits a rebuild of the
+    jobs that write the watched folders, so that the run cannot end before they are
+    written, whatever the machine's speed.
+
+    A killed job leaves its entry unsealed; the user's command computes it again where
+    the run needs it, and leaves it where the run folder is complete without it (the
+    forced rebuild's): asked for, it is computed to the same bytes, and then every
+    entry of the first build is there, sealed as then."""
+    ws, expected, stored = rebuilt
+    for entry in downstream(ws.store, ("simulate",)):
+        discard(entry)
+    shutil.rmtree(ws.out)
+    interrupted_run(ws, expected, stored, ["--cores", "2"], "simulate-*/simulation", first)
+    resume(ws, first)
+    assert_same_bytes(ws, expected, f"interrupted ({first}) and resumed")
     assert_checksums_hold(ws.out)
-    forced_tables = ["--forcerun", *TABLE_RULES, "--cores", "2"]
-    interrupted_run(ws, expected, forced_tables, "tables", second)
-    resume(ws, expected, second)
-    assert_same_bytes(
-        ws, expected, f"interrupted ({second}) and resumed", may_be_missing=INTERMEDIATES
-    )
+    assert_store_holds_the_first_build(ws, stored, f"interrupted ({first}) and resumed")
+
+    forced = ["--forcerun", "pulses", "--cores", "2"]
+    interrupted_run(ws, expected, stored, forced, "*/tables", second)
+    resume(ws, second)
+    assert_same_bytes(ws, expected, f"interrupted ({second}) and resumed")
     assert_checksums_hold(ws.out)
+    assert_store_holds_the_first_build(ws, stored, f"interrupted ({second}) and resumed")
+
+    unsealed = [entry for name, entry in entries(ws.store).items() if name not in seals(ws.store)]
+    if unsealed:
+        asked = [str((entry / SUMS).relative_to(ws.work)) for entry in unsealed]
+        result = snakemake(ws, "--cores", "2", "--rerun-incomplete", *asked)
+        assert result.returncode == 0, tail(result)
+    assert seals(ws.store) == stored, "the store's entries differ from the first build's"
+    assert_store_holds_the_first_build(ws, stored, "the unsealed entries computed")
+    for entry in entries(ws.store).values():
+        assert_checksums_hold(entry)
 
 
-def assert_checksums_hold(out: Path) -> None:
-    """The run folder's SHA256SUMS, where a run left one (each run that ran a job;
-    after a SIGKILL none until then), lists its files as they are."""
-    if (out / "SHA256SUMS").exists():
+def assert_checksums_hold(folder: Path) -> None:
+    """A SHA256SUMS (the run folder's, where a run left one: each run that ran a job;
+    after a SIGKILL none until then; or a store entry's, which lists its outputs and the
+    stored inputs it read) lists its files as they are."""
+    if (folder / SUMS).exists():
         check = subprocess.run(
-            ["sha256sum", "-c", "--quiet", "SHA256SUMS"], cwd=out, capture_output=True, text=True
+            ["sha256sum", "-c", "--quiet", SUMS], cwd=folder, capture_output=True, text=True
         )
-        assert check.returncode == 0, check.stdout + check.stderr
+        assert check.returncode == 0, f"{folder}:\n{check.stdout}{check.stderr}"
 
 
 # ---- part 3: atomic writes (unit) ---------------------------------------------------
