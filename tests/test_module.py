@@ -107,7 +107,7 @@ def started(output: str) -> set[str]:
 
 
 @pytest.mark.workflow
-@pytest.mark.heavy(cpu_s=20)
+@pytest.mark.heavy(cpu_s=5)
 def test_a_lab_uses_the_workflow_as_a_module(tiny_run, tmp_path, env_of_library):
     """The lab's run computes, through the module, the jobs its store lacks, and finds
     the others stored under the keys a plain run gave them; its run folder is in its

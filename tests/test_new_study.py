@@ -141,7 +141,7 @@ def snakemake(work: Path, env: dict, *args: str) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.workflow
-@pytest.mark.heavy(cpu_s=25)
+@pytest.mark.heavy(cpu_s=6)
 def test_a_new_study_in_four_places(tiny_run, tmp_path):
     """The study added to a copy of the tiny run: a dry run lists its rule; the run
     computes only its job, the summary, the article and the run folder; the table is

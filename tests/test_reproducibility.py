@@ -528,11 +528,11 @@ def assert_store_holds_the_first_build(ws: Workspace, stored: dict, what: str) -
 @pytest.mark.parametrize(
     ("first", "second"),
     [
-        pytest.param("SIGINT-group", "SIGKILL-group", marks=pytest.mark.heavy(cpu_s=55)),
+        pytest.param("SIGINT-group", "SIGKILL-group", marks=pytest.mark.heavy(cpu_s=31)),
         pytest.param(
             "SIGTERM-snakemake",
             "SIGTERM-group",
-            marks=[pytest.mark.slow, pytest.mark.heavy(cpu_s=55)],
+            marks=[pytest.mark.slow, pytest.mark.heavy(cpu_s=22)],
         ),
     ],
     ids=["ctrl-c-then-crash", "sigterm-snakemake-then-group"],
