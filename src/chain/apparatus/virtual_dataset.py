@@ -13,14 +13,24 @@ import numpy as np
 import pandas as pd
 
 from chain.apparatus.acquisition import add_noise, newtons_to_volts, quantise, resample
-from chain.apparatus.measured import FORMAT_NAME, METADATA_FILE, write_metadata, write_shot_csv
-from chain.apparatus.virtual_plan import _plan
+from chain.apparatus.measured import (
+    FORMAT_NAME,
+    METADATA_FILE,
+    MeasuredDataError,
+    _shot_table,
+    write_metadata,
+    write_shot_csv,
+)
+from chain.apparatus.metadata import parse_metadata
+from chain.apparatus.shot_files import channel_faults, read_shot_csv
+from chain.apparatus.virtual_plan import _plan, plan_shots
 from chain.apparatus.virtual_settings import VirtualExperiment
 from chain.apparatus.virtual_shots import simulate_virtual_shots
 from chain.atomic import ordinary_mode, replace_folder, temporary_beside, write_text_atomic
 from chain.errors import ParameterError
 from chain.labels import VIRTUAL_LABEL
 from chain.physics.materials import Material
+from chain.traces import META_COLUMNS, sensor_column, validate_traces
 
 #: File beside the shots recording the true launch of each shot (ignored by the loader).
 TRUTH_FILE = "virtual_truth.csv"
@@ -63,14 +73,11 @@ def run_virtual_experiment(
     out.parent.mkdir(parents=True, exist_ok=True)
     with temporary_beside(out, directory=True) as staging:
         os.chmod(staging, ordinary_mode(directory=True))
-        saturated = _write_shots(settings, plan, time, forces, rng, staging)
-        if saturated.any():
-            # A lab would re-range the digitiser; a clipped top biases the amplitude fit.
-            warnings.warn(
-                f"virtual experiment: the ADC saturated (|V| >= {settings.adc_range_V} V) in "
-                f"shots {plan['shot'][saturated].tolist()}; raise adc_range_V",
-                stacklevel=2,
-            )
+        saturated = np.zeros(len(plan), dtype=bool)
+        for i, shot in enumerate(plan.itertuples(index=False)):
+            instants, volts, saturated[i] = _digitise(settings, shot, time, forces[i], rng)
+            write_shot_csv(staging / shot.file, instants, volts, settings.sensor_beads)
+        _warn_saturated(settings, plan, saturated)
         truth = plan.assign(adc_saturated=saturated)
         text = truth.to_csv(index=False, float_format="%.10g", lineterminator="\n")
         write_text_atomic(text, staging / TRUTH_FILE)
@@ -79,20 +86,106 @@ def run_virtual_experiment(
     return out
 
 
-def _write_shots(settings, plan, time, forces, rng, folder: Path) -> np.ndarray:
-    saturated = np.zeros(len(plan), dtype=bool)
-    sensitivities = np.array(settings.sensitivities)
-    for i, shot in enumerate(plan.itertuples(index=False)):
-        instants, sampled = resample(
-            time, forces[i], settings.sampling_interval_s, shot.sampling_phase_s
+def _digitise(settings: VirtualExperiment, shot, time, forces, rng):
+    """One shot as the digitiser records it: (instants (K,) s, volts (n_sensors, K) V,
+    whether the ADC saturated), its noise drawn from ``rng``."""
+    instants, sampled = resample(time, forces, settings.sampling_interval_s, shot.sampling_phase_s)
+    noisy = add_noise(sampled, settings.noise_N, rng)
+    volts = newtons_to_volts(noisy, 1.0) * np.array(settings.sensitivities)[:, None]
+    if settings.adc_bits is None:
+        return instants, volts, False
+    saturated = bool(np.any(np.abs(volts) >= settings.adc_range_V))
+    return instants, quantise(volts, settings.adc_bits, settings.adc_range_V), saturated
+
+
+def _warn_saturated(settings: VirtualExperiment, plan: pd.DataFrame, saturated) -> None:
+    if np.any(saturated):  # a lab would re-range: a clipped top biases the amplitude fit
+        warnings.warn(
+            f"virtual experiment: the ADC saturated (|V| >= {settings.adc_range_V} V) in "
+            f"shots {plan['shot'][saturated].tolist()}; raise adc_range_V",
+            stacklevel=3,
         )
-        noisy = add_noise(sampled, settings.noise_N, rng)
-        volts = newtons_to_volts(noisy, 1.0) * sensitivities[:, None]
-        if settings.adc_bits is not None:
-            saturated[i] = bool(np.any(np.abs(volts) >= settings.adc_range_V))
-            volts = quantise(volts, settings.adc_bits, settings.adc_range_V)
-        write_shot_csv(folder / shot.file, instants, volts, settings.sensor_beads)
-    return saturated
+
+
+#: The settings that move the speeds or the delay of some shots and nothing else: the
+#: same random draws, chain, time grid (with a set time step) and digitiser.
+_LAUNCH_DRAWS = {"speed_mismatch", "reference_speed_mismatch", "timing_jitter_s"}
+_LAUNCH_DRAWS |= {"right_speed_offset", "right_delay_s"}
+
+
+def _shots_of(settings: VirtualExperiment, plan: pd.DataFrame, other) -> np.ndarray:
+    """Which shots of ``plan`` (of ``settings``) are the shots of the virtual experiment
+    ``other`` to the bit: the settings, with a set time step, differ at most in
+    :data:`_LAUNCH_DRAWS`, and the shot's launch and sampling phase are its."""
+    mine, theirs = asdict(settings), asdict(other)
+    if settings.time_step_s is None or any(
+        mine[key] != theirs[key] for key in mine if key not in _LAUNCH_DRAWS
+    ):
+        return np.zeros(len(plan), dtype=bool)
+    columns = ["kind", "v_left_m_s", "v_right_m_s", "delay_s", "sampling_phase_s"]
+    return (plan[columns] == plan_shots(other)[columns]).all(axis=1).to_numpy()
+
+
+def virtual_traces(
+    settings: VirtualExperiment,
+    dataset_name: str,
+    known: dict | None = None,
+    run: tuple[VirtualExperiment, str | os.PathLike] | None = None,
+) -> pd.DataFrame:
+    """The trace table that :func:`chain.apparatus.measured.load_dataset` reads from
+    the dataset :func:`run_virtual_experiment` writes with these settings, to the bit
+    (the files' 10 significant digits of time and 7 of volts included), made in memory.
+
+    Parameters
+    ----------
+    settings : VirtualExperiment
+        The apparatus and the shot plan.
+    dataset_name : str
+        The ``model`` column.
+    known : dict, optional
+        Launches integrated already (:func:`simulate_virtual_shots`), filled here.
+    run : (VirtualExperiment, path), optional
+        Another virtual experiment and its dataset folder (the run's): the shots that
+        are its shots to the bit are read from its files instead of integrated again.
+    """
+    rng = np.random.default_rng(settings.seed)
+    plan = _plan(settings, rng)
+    read = np.zeros(len(plan), dtype=bool) if run is None else _shots_of(settings, plan, run[0])
+    time, integrated = None, iter(())
+    if not read.all():
+        time, forces = simulate_virtual_shots(settings, plan, known, wanted=~read)
+        integrated = iter(forces)
+    meta = parse_metadata(_metadata(settings, plan, dataset_name))
+    tables, saturated = [], np.zeros(len(plan), dtype=bool)
+    for i, shot in enumerate(plan.itertuples(index=False)):
+        if read[i]:
+            instants, volts = read_shot_csv(Path(run[1]) / shot.file, settings.sensor_beads)
+            add_noise(np.zeros(volts.shape), settings.noise_N, rng)  # the draws it took
+        else:
+            digitised = _digitise(settings, shot, time, next(integrated), rng)
+            (instants, volts), saturated[i] = _as_written(*digitised[:2]), digitised[2]
+        faults = channel_faults(shot.file, volts, settings.sensor_beads)
+        if faults:
+            raise MeasuredDataError("\n".join(faults))
+        tables.append(_shot_table(meta, dataset_name, i, instants, volts))
+    _warn_saturated(settings, plan, saturated)
+    columns = list(META_COLUMNS) + [sensor_column(b) for b in settings.sensor_beads]
+    table = pd.concat(tables, ignore_index=True)[columns]
+    return validate_traces(table, where=f"virtual experiment {dataset_name}")
+
+
+def _as_written(instants: np.ndarray, volts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A shot's samples as its file holds them: (times (K,) s, volts (n_sensors, K) V)
+    as :func:`chain.apparatus.measured.write_shot_csv` writes them (times with 10
+    significant digits, volts with 7) and :func:`~chain.apparatus.measured.read_shot_csv`
+    parses them (Python's correctly rounded conversions both ways: one result per value,
+    so a digitiser's few distinct values are converted once each)."""
+    distinct, where = np.unique(volts + 0.0, return_inverse=True)  # -0 written as 0
+    return _rounded(instants, "%.10g"), _rounded(distinct, "%.7g")[where].reshape(volts.shape)
+
+
+def _rounded(values: np.ndarray, form: str) -> np.ndarray:
+    return np.array((f"{form} " * values.size % tuple(values.tolist())).split(), dtype=float)
 
 
 def _metadata(settings: VirtualExperiment, plan: pd.DataFrame, dataset_name: str) -> dict:

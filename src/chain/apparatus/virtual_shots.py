@@ -3,8 +3,11 @@ batch by batch, read at the sensors (a MODEL; see :mod:`chain.apparatus.virtual`
 
 from __future__ import annotations
 
+import hashlib
 import itertools
+import logging
 import math
+from dataclasses import asdict
 
 import numpy as np
 import pandas as pd
@@ -25,6 +28,17 @@ RECORD_OVERSAMPLING = 4
 
 #: Launches per integrator call: bounds memory (a few MB per launch).
 MAX_BATCH = 16
+
+#: Fields of VirtualExperiment that a launch's integration does not read, or reads
+#: through what they make (the shots' speeds and delays, the chain's radii and gaps, the
+#: time step): a launch is known by the others (:func:`simulate_virtual_shots`).
+_NOT_INTEGRATED = set(
+    "seed impact_speeds_m_s drop_heights_m collision_shots reference_shots speed_mismatch "
+    "reference_speed_mismatch timing_jitter_s right_speed_offset right_delay_s noise_N adc_bits "
+    "adc_range_V sensitivity_mV_per_N time_step_s radius_dispersion gap_mean_m gap_spread_m".split()
+)
+
+log = logging.getLogger(__name__)
 
 
 def _launcher(model, side: int) -> slice:
@@ -138,36 +152,53 @@ def _sensor_forces(settings, model, plan, dt, record_interval, rest):
 
 
 def simulate_virtual_shots(
-    settings: VirtualExperiment, plan: pd.DataFrame
+    settings: VirtualExperiment,
+    plan: pd.DataFrame,
+    known: dict | None = None,
+    wanted: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Integrate the shots of ``plan`` (from :func:`plan_shots`) with the apparatus model:
     (simulated fine time (S,) s from the first impact, sensor readings (B, n_sensors, S)
-    N of every shot of ``plan``, in plan order).
+    N of every shot of ``plan``, or of the ``wanted`` ones (bool (len(plan),)), in plan
+    order).
 
     Collision shots use a chain with both strikers, reference shots one with the left
-    striker only, both with the same time step; each kind is batched. With
-    ``launch="bead"`` there are no strikers (the end beads are launched) and with
-    ``readout="felt"`` no split sensor beads.
+    striker only, both with the same time step (from the fastest shot of ``plan``); each
+    kind is batched. With ``launch="bead"`` there are no strikers (the end beads are
+    launched) and with ``readout="felt"`` no split sensor beads. Each distinct launch
+    (chain, time step, kind, speeds, delay) is integrated once: a repeat, in ``plan`` or
+    in ``known`` (launch -> (time, readings), filled here; one dict for calls that may
+    share launches), takes its readings, the same to the bit (each launch is integrated
+    on its own). The log names each launch integrated by a digest of its readings.
     """
     check_switches(settings)
     radii, gaps = chain_draws(settings)
     both = apparatus_chain(settings, "both", radii)
-    left = apparatus_chain(settings, "left", radii)
     record_interval = settings.sampling_interval_s / RECORD_OVERSAMPLING
     fastest = float(plan[["v_left_m_s", "v_right_m_s"]].to_numpy().max())
     dt = settings.time_step_s or TIME_STEP_COARSENING * default_time_step(both, fastest)
     # A whole number of steps per recorded sample keeps the record grid exact.
     dt = record_interval / math.ceil(record_interval / dt - 1e-9)
-    forces = np.empty((len(plan), len(settings.sensor_beads), 0))
-    time = None
-    for kind, model in (("collision", both), ("reference", left)):
-        rows = np.flatnonzero(plan["kind"].to_numpy() == kind)
-        if rows.size == 0:
+    chain = (*((k, repr(v)) for k, v in asdict(settings).items() if k not in _NOT_INTEGRATED),
+             dt, radii.tobytes(), gaps.tobytes())  # fmt: skip
+    columns = ["kind", "v_left_m_s", "v_right_m_s", "delay_s"]
+    launches = [(chain, *row) for row in plan[columns].itertuples(index=False, name=None)]
+    if wanted is not None:
+        plan, launches = plan[wanted], [k for k, w in zip(launches, wanted) if w]
+    known = {} if known is None else known
+    for kind, strikers in (("collision", "both"), ("reference", "left")):
+        new: dict = {}  # launch -> its first shot
+        for i, k in enumerate(launches):
+            if k[1] == kind and k not in known:
+                new.setdefault(k, i)
+        if not new:
             continue
-        time, kind_forces = _sensor_forces(
-            settings, model, plan.iloc[rows], dt, record_interval, rest_displacement(model, gaps)
-        )
-        if forces.shape[2] == 0:
-            forces = np.empty((len(plan), len(settings.sensor_beads), time.size))
-        forces[rows] = kind_forces
-    return time, forces
+        model = both if strikers == "both" else apparatus_chain(settings, "left", radii)
+        time, readings = _sensor_forces(
+            settings, model, plan.iloc[list(new.values())], dt, record_interval,
+            rest_displacement(model, gaps),
+        )  # fmt: skip
+        known.update((k, (time, r)) for k, r in zip(new, readings))
+        digests = [hashlib.blake2b(r.tobytes(), digest_size=8).hexdigest() for r in readings]
+        log.info("integrated %d %s launches: %s", len(new), kind, " ".join(digests))
+    return known[launches[0]][0], np.stack([known[k][1] for k in launches])
