@@ -420,6 +420,19 @@ def test_the_run_folder_gets_checked_plain_copies_and_the_jobs_records(chain_of_
     assert sha256sum_c(run).returncode == 0
 
 
+def test_a_file_the_run_no_longer_shows_leaves_the_folders_it_shows(chain_of_two, tmp_path):
+    """A table an earlier config showed (a study switched off since) leaves tables/, so
+    that SHA256SUMS certifies this run's folder alone; a file of the user's beside the
+    folders the run fills (an HTML report) stays."""
+    make, use = chain_of_two
+    run = tmp_path / "results" / "paper"
+    fill(run, {"tables/a.csv": make / "a.csv", "tables/b.csv": use / "b.csv"})
+    (run / "report.html").write_text("<html/>")
+    fill(run, {"tables/b.csv": use / "b.csv"})
+    assert not (run / "tables" / "a.csv").exists() and (run / "report.html").exists()
+    assert "tables/a.csv" not in listed(run / CHECKSUMS)
+
+
 def test_hertzchain_check_explains_what_sha256sum_rejects(chain_of_two, tmp_path):
     """A file changed since, a file added after, no SHA256SUMS (a failed or interrupted
     run): each named, in words."""

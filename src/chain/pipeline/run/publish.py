@@ -51,6 +51,13 @@ def fill_run_folder(sources: Sequence[str], targets: Sequence[str], sums: str) -
     folder = Path(sums).parent
     for name in RECORDS:
         shutil.rmtree(folder / name, ignore_errors=True)
+    # A file an earlier run of another config put in one of the folders the run shows
+    # (a study switched off since) goes: the folder shows this run alone.
+    wanted = {os.path.normpath(t) for t in targets}
+    shown = {Path(t).relative_to(folder).parts[0] for t in targets if Path(t).parent != folder}
+    for path in (p for name in shown for p in (folder / name).rglob("*") if p.is_file()):
+        if os.path.normpath(path) not in wanted:
+            path.unlink()
     digests = {}
     for source, target in zip(sources, targets, strict=True):
         digests[os.path.normpath(target)] = _copy_checked(Path(source), Path(target))
