@@ -39,7 +39,8 @@ def config_hash(config: Mapping) -> str:
 
 def _git(directory: str | os.PathLike, *args: str) -> str | None:
     """Output of ``git -C directory args``, or None where git or the checkout is absent."""
-    command = ["git", "-C", os.fspath(directory), *args]
+    # No optional lock: `git status` would otherwise rewrite the checkout's index.
+    command = ["git", "--no-optional-locks", "-C", os.fspath(directory), *args]
     env = {**os.environ, "LC_ALL": "C", "TZ": "UTC"}
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=20, env=env)
