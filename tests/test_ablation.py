@@ -2,6 +2,7 @@
 into the paper's simulation, and the config-driven variants
 (chain.pipeline.config.ablation, chain.studies.ablation_table)."""
 
+import collections
 import copy
 import dataclasses
 import math
@@ -213,26 +214,44 @@ def test_ablation_table_keeps_the_runs_seed_and_the_spread_over_seeds():
     assert math.isnan(single.iloc[0]["exponent_seed_std"])
 
 
-def test_a_variant_reading_the_runs_experiment_gets_what_simulating_gives(tmp_path, monkeypatch):
-    """A replicate with the run's own settings reads the run's virtual experiment
-    (RunPlan.ablation_datasets) instead of simulating it: the same traces, pulses and
-    selection, to the bit, as simulating those shots again, noise and mismatch included."""
-    from chain.studies import ablation
-    from chain.studies.ablation import run_variant_shots
+KINDS = {"collision", "reference"}
+
+
+@pytest.mark.parametrize(
+    ("change", "read", "integrated"),
+    [
+        ({}, "all", 0),  # the run itself: every shot read from its files
+        ({"reference_speed_mismatch": 0.0}, "collision", 2),  # one reference per amplitude
+        ({"noise_N": 0.0, "adc_bits": None}, "none", 6),  # the run's launches, other readings
+        ({"speed_mismatch": 0.0, "timing_jitter_s": 0.0, "noise_N": 0.0}, "none", 4),
+    ],
+)
+def test_shots_in_memory_are_those_a_dataset_holds(tmp_path, caplog, change, read, integrated):
+    """A variant's shots made in memory (virtual_traces) are the trace table that loading
+    the dataset the virtual experiment writes gives, to the bit (the files' 7 digits of
+    volts included), whether a shot is integrated or read from the run's files (the same
+    launch, draws and digitiser: reference_speed_mismatch moves the references only);
+    and each distinct launch is integrated once (without mismatch or jitter the two
+    collisions of an amplitude are one launch, and so is its reference)."""
+    from chain.apparatus.measured import load_dataset
+    from chain.apparatus.virtual import run_virtual_experiment
+    from chain.apparatus.virtual_dataset import virtual_traces
 
     chains, datasets = written_datasets(tmp_path, seed=7)
-    simulated = run_variant_shots(chains, 0.05, series="virtual")
-
-    def no_simulation(*args, **kwargs):
-        raise AssertionError("simulated although the datasets were given")
-
-    monkeypatch.setattr(ablation, "run_virtual_experiment", no_simulation)
-    shared = run_variant_shots(chains, 0.05, series="virtual", datasets=datasets)
-    for mine, theirs in zip(simulated[0], shared[0], strict=True):
-        pd.testing.assert_frame_equal(mine, theirs, check_exact=True)
-    pd.testing.assert_frame_equal(simulated[1], shared[1], check_exact=True)
-    pd.testing.assert_frame_equal(simulated[2], shared[2], check_exact=True)
-    assert len(shared[1]) > 0 and shared[2]["kept"].any()
+    run = (VirtualExperiment.from_dict(chains[0]), datasets[0])
+    settings = dataclasses.replace(run[0], **change)
+    expected = load_dataset(run_virtual_experiment(settings, tmp_path / "v", "virtual"))
+    caplog.set_level("INFO", logger="chain.apparatus.virtual_shots")
+    caplog.clear()
+    known = {}
+    traces = virtual_traces(settings, "virtual", known, run=run)
+    pd.testing.assert_frame_equal(traces, expected, check_exact=True)
+    digests = [d for r in caplog.records for d in r.getMessage().split(": ")[1].split()]
+    assert len(digests) == len(set(digests)) == len(known) == integrated
+    kinds = {r.getMessage().split()[2] for r in caplog.records}
+    assert kinds == {"all": set(), "collision": {"reference"}}.get(read, KINDS)
+    assert virtual_traces(settings, "virtual", known, run=run).equals(traces)
+    assert len(known) == integrated  # the second time, every launch is known
 
 
 def written_datasets(folder: Path, seed: int) -> tuple[list[dict], list[Path]]:
@@ -269,32 +288,21 @@ def virtual_experiment_settings_of(n_beads: int, sensors) -> dict:
     return dataclasses.asdict(settings)
 
 
-def test_fitting_every_estimator_gives_each_the_fits_it_gets_alone(tmp_path):
-    """A variant's job fits every estimator of the run, so that a what-if picking
-    another main estimator reuses it: each estimator's delay fits and SSW fits, its own
-    shot selection included, are those an analysis with that estimator alone gives,
-    to the bit."""
-    from chain.analysis.recipe import fit_pulses
-    from chain.analysis.rows import of_estimator
-    from chain.studies.ablation import analyse_datasets, variant_fits
-    from chain.studies.mechanism_fits import variant_ssw_fits
-
-    _, datasets = written_datasets(tmp_path, seed=11)
-    estimators = ("fit_full", "peak", "fit_rise")
-    traces, pulses, _ = analyse_datasets(datasets, None, estimators, "virtual")
-    fits, ssw_fits = variant_fits(traces, pulses, 0.05, estimators)
-    assert set(fits["estimator"]) == set(ssw_fits["estimator"]) == set(estimators)
-    for estimator in estimators:
-        alone_traces, alone, selection = analyse_datasets(datasets, 0.05, [estimator], "virtual")
-        expected = fit_pulses(alone, selection)
-        pd.testing.assert_frame_equal(of_estimator(fits, estimator), expected, check_exact=True)
-        expected_ssw = variant_ssw_fits(alone_traces, alone, selection, estimator)
-        pd.testing.assert_frame_equal(
-            of_estimator(ssw_fits, estimator).drop(columns="estimator"),
-            expected_ssw,
-            check_exact=True,
-        )
-        assert selection["kept"].any() and np.isfinite(expected["C_us_N16"]).any()
+def test_the_tiny_runs_launches_are_each_integrated_once(tiny_run):
+    """Every launch of the virtual experiment in the tiny run is integrated once: no two
+    integrated launches of its jobs (the run's virtual experiment, the ablation
+    variants) give bit-identical sensor readings. A variant whose shots are the run's
+    reads them, and one whose launches another variant integrated takes those."""
+    logs = sorted((tiny_run / "results" / "tiny" / "logs").rglob("*.log"))
+    launches = {}
+    for path in logs:
+        for line in path.read_text().splitlines():
+            if " launches: " in line and "chain.apparatus.virtual_shots" in line:
+                launches.setdefault(path.stem, []).extend(line.split(" launches: ")[1].split())
+    assert {"N16", "N17", "ablation_variants"} <= set(launches), sorted(launches)
+    counted = collections.Counter(d for digests in launches.values() for d in digests)
+    repeated = {d: n for d, n in counted.items() if n > 1}
+    assert not repeated, f"{len(repeated)} launches integrated more than once"
 
 
 def test_rows_of_an_estimator_need_the_column():

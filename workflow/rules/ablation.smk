@@ -1,74 +1,55 @@
-# The ablation study (the virtual experiment, a MODEL, not data): one job per variant of
-# ablation.variants reruns the virtual experiment of every chain with one ingredient
-# changed (chain.studies.ablation), analyses it as the pipeline analyses the experiment,
-# and fits C and a free exponent; ablation_table gathers the variants. The default run
-# has the variants marked default_run (tables/ablation_exponent.csv); studies.ablation:
-# full adds every variant (tables/ablation_exponent_all.csv). A replicate with the run's
-# own settings reads the run's virtual experiment, and a variant whose settings equal
-# an earlier one's (its twin) is that one's job.
+# The ablation study (the virtual experiment, a MODEL, not data): one job reruns the
+# virtual experiment of every chain for each variant the run makes (ablation.variants:
+# the default run's, with the mechanism study's candidates; studies.ablation: full, all),
+# with one ingredient changed (chain.studies.ablation), in memory; each distinct launch is
+# integrated once, and the shots that are the run's virtual experiment's are read from
+# its datasets. It analyses them with the main estimator as the pipeline analyses the
+# experiment, fits C and a free exponent, and tabulates the default run's variants
+# (tables/ablation_exponent.csv) and, with studies.ablation: full, every variant
+# (tables/ablation_exponent_all.csv). A job: a few seconds of work, a second of start-up.
 
 from chain.pipeline.plan.ablation import AblationPlan
 
 ABLATION = AblationPlan(PLAN)
 
 
-rule ablation_variant:
+rule ablation_variants:
     input:
-        datasets=lambda w: (
-            virtual_datasets(w) if any(ABLATION.reads_run(w.variant)) else []
-        ),
+        datasets=virtual_datasets,
     output:
-        fits=stored("ablation_variant", "ablation/{variant}_fits.csv", "{variant}"),
-        ssw_fits=stored(
-            "ablation_variant", "ablation/{variant}_ssw_fits.csv", "{variant}"
-        ),
-        sums=stored("ablation_variant", "SHA256SUMS", "{variant}"),
+        fits=stored("ablation_variants", "ablation/fits.csv"),
+        ssw_fits=stored("ablation_variants", "ablation/ssw_fits.csv"),
+        table=stored("ablation_variants", "tables/ablation_exponent.csv"),
+        table_all=stored("ablation_variants", "tables/ablation_exponent_all.csv"),
+        sums=stored("ablation_variants", "SHA256SUMS"),
     log:
-        stored("ablation_variant", "log", "{variant}"),
+        stored("ablation_variants", "log"),
     benchmark:
-        stored("ablation_variant", "benchmark.tsv", "{variant}")
+        stored("ablation_variants", "benchmark.tsv")
     priority: 1
     conda:
         ENV
+    resources:
+        mem_mb=1000,  # MB
+        runtime=30,  # minutes
     params:
-        settings=lambda w: ABLATION.settings(w.variant),
-        reads_run=lambda w: ABLATION.reads_run(w.variant),
-        tolerance=lambda w: ABLATION.tolerance(w.variant),
-        estimators=config["analysis"]["estimators"],
-        series=PLAN.experiment.series,
-    script:
-        "../scripts/ablation_variant.py"
-
-
-rule ablation_table:
-    input:
-        fits=lambda w: [
-            output_of("ablation_variant", "fits", variant=ABLATION.job(name))
-            for name in ABLATION.names(full=w.which == "all")
-        ],
-    output:
-        table=stored("ablation_table", "tables/ablation_exponent.csv", "{which}"),
-        sums=stored("ablation_table", "SHA256SUMS", "{which}"),
-    log:
-        stored("ablation_table", "log", "{which}"),
-    benchmark:
-        stored("ablation_table", "benchmark.tsv", "{which}")
-    conda:
-        ENV
-    params:
-        variants=lambda w: ABLATION.names(full=w.which == "all"),
+        variants=lambda w: ABLATION.job(),
+        run=lambda w: ABLATION.run,
         estimator=config["analysis"]["main_estimator"],
+        series=PLAN.experiment.series,
+        table=lambda w: ABLATION.names(full=False),
+        table_all=lambda w: ABLATION.names(full=ABLATION.full),
         overrides=ABLATION.overrides,
     script:
-        "../scripts/ablation_table.py"
+        "../scripts/ablation_variants.py"
 
 
 if ABLATION.names(full=False):
-    publish("tables/ablation_exponent.csv", "ablation_table", "table", which="default")
+    publish("tables/ablation_exponent.csv", "ablation_variants", "table")
     summarise(
         "ablation",
         "chain.report.numbers.spread:ablation_summary",
-        table=("ablation_table", "table", {"which": "default"}),
+        table=("ablation_variants", "table", {}),
     )
 if ABLATION.full:
-    publish("tables/ablation_exponent_all.csv", "ablation_table", "table", which="all")
+    publish("tables/ablation_exponent_all.csv", "ablation_variants", "table_all")

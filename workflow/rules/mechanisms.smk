@@ -10,6 +10,7 @@
 from chain.pipeline.plan.mechanisms import MechanismPlan
 
 MECHANISMS = MechanismPlan(PLAN, ABLATION)
+CANDIDATES = MECHANISMS.candidates(full=False)  # none, or the reference and more
 for line in MECHANISMS.notes() if workflow.is_main_process else []:
     print(line, file=sys.stderr)
 
@@ -101,14 +102,9 @@ rule ssw_mechanisms:
             for setting in MECHANISMS.settings("viscous", full=w.which == "all")
             for n in PLAN.chains
         ],
-        candidate_fits=lambda w: [
-            output_of("ablation_variant", "fits", variant=ABLATION.job(name))
-            for name in MECHANISMS.candidates(full=w.which == "all")
-        ],
-        candidate_ssw_fits=lambda w: [
-            output_of("ablation_variant", "ssw_fits", variant=ABLATION.job(name))
-            for name in MECHANISMS.candidates(full=w.which == "all")
-        ],
+        # The ablation job's fits of every variant it made, the candidates' among them.
+        candidate_fits=made("ablation_variants", "fits") if CANDIDATES else [],
+        candidate_ssw_fits=made("ablation_variants", "ssw_fits") if CANDIDATES else [],
     output:
         table=stored("ssw_mechanisms", "tables/ssw_mechanisms.csv", "{which}"),
         sums=stored("ssw_mechanisms", "SHA256SUMS", "{which}"),

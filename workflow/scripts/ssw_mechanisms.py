@@ -1,6 +1,6 @@
 """tables/ssw_mechanisms.csv: SSW/F_m at S2 and C of the run's main estimator (params
 estimator) per mechanism and setting: the LAMMPS friction/rotation sweep and the virtual
-experiment's candidates (chain.studies.mechanism_table)."""
+experiment's candidates, from the ablation job's fits (chain.studies.mechanism_table)."""
 
 import pandas as pd
 from _logging import done, start
@@ -27,16 +27,10 @@ if lammps[0]:
 if viscous[0]:
     both = [lammps[0] + viscous[0], lammps[1] + viscous[1]]
     tables.append(mechanism_rows(VISCOUS_MECHANISM, p.viscous_labels, *both, p.lammps_reference))
-if p.candidates:
-    names = list(p.candidates)
-    tables.append(
-        candidate_rows(
-            {name: tuple(value) for name, value in p.candidates.items()},
-            dict(zip(names, read(i.candidate_fits))),
-            dict(zip(names, read(i.candidate_ssw_fits))),
-            p.candidate_reference,
-        )
-    )
+if p.candidates:  # the ablation job's fits of every variant it made, as written
+    fits = read([i.candidate_fits, i.candidate_ssw_fits])
+    candidates = {name: tuple(value) for name, value in p.candidates.items()}
+    tables.append(candidate_rows(candidates, *fits, p.candidate_reference))
 table = pd.concat(tables, ignore_index=True)
 log.info("%d rows", len(table))
 write_csv_atomic(table, snakemake.output[0])

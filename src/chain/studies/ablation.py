@@ -1,136 +1,121 @@
-"""Ablation of the virtual experiment: rerun it with one ingredient changed at a time.
-
-The virtual experiment (:mod:`chain.apparatus.virtual`, a MODEL of the apparatus) is
-the paper's simulation plus apparatus ingredients, the 5 % acceptance protocol and its
-own range of amplitudes. A variant changes some of them
-(:mod:`chain.pipeline.config.ablation` maps the config's ``ablation.variants`` to the
-settings of each chain). :func:`run_variant_shots` runs the virtual experiment of every
-chain with those settings (the same seed as the run, so a variant with no overrides
-reproduces the run's experiment) and :func:`variant_fits` fits Delta = C F_m^(-1/6) and
-a free power law as every series is fitted (:mod:`chain.analysis.recipe`); replicates
-repeat it with other seeds to show the spread a seed gives
-(:mod:`chain.studies.ablation_table`).
+"""Ablation of the virtual experiment (:mod:`chain.apparatus.virtual`, a MODEL of the
+apparatus): rerun it with one ingredient changed at a time (a variant,
+:mod:`chain.pipeline.config.ablation`) at the run's seed (a variant with no overrides is
+the run's experiment) and at the seeds of its replicates, and fit Delta = C F_m^(-1/6)
+and a free power law as every series is fitted (:mod:`chain.analysis.recipe`);
+:mod:`chain.studies.ablation_table` tabulates them.
 """
 
 from __future__ import annotations
 
+import json
+import logging
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import pandas as pd
 
 from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.recipe import fit_pulses
-from chain.analysis.rows import of_estimator
 from chain.analysis.selection import select_shots
-from chain.apparatus.measured import load_dataset
-from chain.apparatus.virtual import VirtualExperiment, run_virtual_experiment
+from chain.analysis.ssw import ssw_fit_table, ssw_table
+from chain.apparatus.virtual import VirtualExperiment
+from chain.apparatus.virtual_dataset import virtual_traces
 from chain.labels import VIRTUAL_SERIES
-from chain.studies.mechanism_fits import variant_ssw_fits
 
-
-def run_variant_shots(
-    settings_per_chain: Sequence[Mapping],
-    tolerance: float | None,
-    estimators: Sequence[str] = ("fit_full",),
-    series: str = VIRTUAL_SERIES,
-    datasets: Sequence[str | os.PathLike] | None = None,
-) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
-    """Run the virtual experiment on each chain and fit its pulses and select its shots
-    as the pipeline does; returns what :func:`analyse_datasets` does.
-
-    The shots go through the measured-data path: written in the measured-trace format
-    to a temporary folder, then analysed by :func:`analyse_datasets`. With
-    ``datasets`` (one folder per chain, written by the virtual experiment with exactly
-    ``settings_per_chain`` and ``series``: the run's own), those are analysed instead
-    of simulating the same shots again.
-
-    Parameters
-    ----------
-    settings_per_chain : sequence of mapping
-        VirtualExperiment fields, one mapping per chain
-        (:func:`chain.pipeline.config.ablation.variant_settings`).
-    tolerance : float or None
-        Acceptance tolerance (relative amplitude mismatch); None keeps every shot.
-    estimators : sequence of str
-        Pulse estimators (:data:`chain.analysis.pulses.ESTIMATORS`).
-    series : str
-        Series name (the ``model`` column).
-    datasets : sequence of path, optional
-        The chains' dataset folders, already written.
-    """
-    if datasets:
-        return analyse_datasets(datasets, tolerance, estimators, series)
-    with tempfile.TemporaryDirectory(prefix="ablation.") as folder:
-        written = []
-        for i, fields in enumerate(settings_per_chain):
-            written.append(Path(folder) / f"chain{i}")
-            run_virtual_experiment(VirtualExperiment.from_dict(fields), written[-1], series)
-        return analyse_datasets(written, tolerance, estimators, series)
-
-
-def analyse_datasets(
-    datasets: Sequence[str | os.PathLike],
-    tolerance: float | None,
-    estimators: Sequence[str] = ("fit_full",),
-    series: str = VIRTUAL_SERIES,
-) -> tuple[list[pd.DataFrame], pd.DataFrame, pd.DataFrame | None]:
-    """Load a variant's shots, fit their pulses per chain and select the collisions
-    with ``tolerance``, as the pipeline does: (the trace table of each chain, their
-    pulse rows, the shot selection or None with ``tolerance`` None).
-
-    Parameters
-    ----------
-    datasets : sequence of path
-        Dataset folders in the measured-trace format, one per chain.
-    tolerance, estimators, series
-        As :func:`run_variant_shots`.
-    """
-    traces = [load_dataset(folder, name=series) for folder in datasets]
-    table = pd.concat(
-        [pulse_table(t, estimators=tuple(estimators)) for t in traces], ignore_index=True
-    )
-    selection = None
-    if tolerance is not None:
-        selection = select_shots(table, tolerance, estimator=estimators[0])
-    return traces, table, selection
+log = logging.getLogger(__name__)
 
 
 def variant_fits(
     traces: Sequence[pd.DataFrame],
-    pulses: pd.DataFrame,
     tolerance: float | None,
-    estimators: Sequence[str],
-) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """A variant's delay fits (:func:`chain.analysis.recipe.fit_pulses` rows) and SSW
-    fits at S2 (:func:`chain.studies.mechanism_fits.variant_ssw_fits` rows with an
-    ``estimator`` column) with each estimator, one after the other, each with the shot
-    selection the acceptance protocol makes with that estimator.
-
-    Every estimator is fitted so that a what-if choosing another main estimator
-    reuses the variant (its simulation is the costly part); the tables reporting it
-    take the main estimator's rows (:func:`chain.analysis.rows.of_estimator`).
+    estimator: str = "fit_full",
+    ssw: bool = True,
+) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+    """A variant's delay fits (:func:`chain.analysis.recipe.fit_pulses` rows) and, with
+    ``ssw``, fits of SSW = slope x F_m at S2 behind the LSTW
+    (:func:`chain.analysis.ssw.ssw_fit_table` rows; else None) with one pulse estimator,
+    the shots selected by the acceptance protocol with it.
 
     Parameters
     ----------
     traces : sequence of DataFrame
-        The trace table of each chain (:func:`run_variant_shots`).
-    pulses : DataFrame
-        Their pulse rows with every estimator of ``estimators``.
+        The trace table of each chain.
     tolerance : float or None
         Acceptance tolerance of the 5 % protocol (relative); None keeps every shot.
-    estimators : sequence of str
-        Pulse estimators.
+    estimator : str
+        Pulse estimator (:data:`chain.analysis.pulses.ESTIMATORS`).
+    ssw : bool
+        Whether to fit the SSW too.
     """
-    fits, ssw_fits = [], []
-    for estimator in estimators:
-        rows = of_estimator(pulses, estimator)
-        selection = None
-        if tolerance is not None:
-            selection = select_shots(rows, tolerance, estimator=estimator)
-        fits.append(fit_pulses(rows, selection))
-        ssw = variant_ssw_fits(traces, rows, selection, estimator)
-        ssw_fits.append(ssw.assign(estimator=estimator))
-    return pd.concat(fits, ignore_index=True), pd.concat(ssw_fits, ignore_index=True)
+    pulses = pd.concat([pulse_table(t, estimators=(estimator,)) for t in traces], ignore_index=True)
+    selection = None
+    if tolerance is not None:
+        selection = select_shots(pulses, tolerance, estimator=estimator)
+    if not ssw:
+        return fit_pulses(pulses, selection), None
+    # Read at S2 only: without S1's crossed pulses, S1's rows are empty ones, at no cost.
+    at_s2 = pulses[(pulses["sensor"] != "S1") | (pulses["role"] != "crossed")]
+    rows = pd.concat(
+        [ssw_table(t, at_s2[at_s2["N"] == t["N"].iloc[0]], selection, estimator=estimator)
+         for t in traces],
+        ignore_index=True,
+    )  # fmt: skip
+    return fit_pulses(pulses, selection), ssw_fit_table(rows[rows["sensor"] == "S2"])
+
+
+def run_variants(
+    variants: Mapping[str, Mapping],
+    run: Sequence[Mapping],
+    datasets: Sequence[str | os.PathLike],
+    estimator: str = "fit_full",
+    series: str = VIRTUAL_SERIES,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Every variant, replicate after replicate: its shots made in memory
+    (:func:`chain.apparatus.virtual_dataset.virtual_traces`; each distinct launch
+    integrated once for all of them, the shots that are the run's read from its
+    datasets) and fitted (:func:`variant_fits`); a replicate whose settings an earlier
+    one had is not analysed again. Returns (delay fits, SSW fits of the variants with
+    ``ssw``), each row with ``variant``, ``estimator`` and ``replicate`` (0 is the run's
+    seed), the delay fits with the ``seeds`` of the chains.
+
+    Parameters
+    ----------
+    variants : mapping
+        Variant name -> {"settings": per replicate, the VirtualExperiment fields of every
+        chain (:func:`chain.pipeline.config.ablation.variant_settings`); "tolerance":
+        relative, or None to keep every collision shot; "ssw": fit the SSW too}.
+    run, datasets : sequence
+        The run's virtual experiment of each chain (its fields) and its dataset folder.
+    estimator : str
+        Pulse estimator (:data:`chain.analysis.pulses.ESTIMATORS`).
+    series : str
+        Series name (the ``model`` column).
+    """
+    runs = [(VirtualExperiment.from_dict(r), d) for r, d in zip(run, datasets, strict=True)]
+    known, analysed, fits, ssw_fits = {}, {}, [], []
+    for name, variant in variants.items():
+        tolerance, fit_ssw = variant["tolerance"], variant["ssw"]
+        for replicate, chains in enumerate(variant["settings"]):
+            key = json.dumps([chains, tolerance, fit_ssw])
+            if key not in analysed:
+                traces = [
+                    virtual_traces(VirtualExperiment.from_dict(c), series, known, run=r)
+                    for c, r in zip(chains, runs, strict=True)
+                ]
+                analysed[key] = variant_fits(traces, tolerance, estimator, fit_ssw)
+            delays, ssw = analysed[key]
+            pooled = delays[delays["N"].astype(str) == "pooled"].iloc[0]
+            seeds = " ".join(str(c["seed"]) for c in chains)
+            log.info(
+                "%s replicate %d (seeds %s), %s: C = %.2f +- %.2f us N^1/6, exponent %.4f +- %.4f",
+                *(name, replicate, seeds, estimator),
+                *pooled[["C_us_N16", "C_stderr_us_N16", "exponent", "exponent_stderr"]],
+            )
+            tags = {"estimator": estimator, "replicate": replicate}
+            for rows, table in ((delays.assign(**tags, seeds=seeds), fits), (ssw, ssw_fits)):
+                if rows is not None:
+                    table.append(rows.assign(**tags))
+                    table[-1].insert(0, "variant", name)
+    ssw = pd.concat(ssw_fits, ignore_index=True) if ssw_fits else pd.DataFrame(columns=["variant"])
+    return pd.concat(fits, ignore_index=True), ssw

@@ -2,9 +2,8 @@
 every variant of the virtual experiment, at the run's seed and over the seeds of its
 replicates.
 
-The fits come from :func:`chain.studies.ablation.variant_fits` (one ``_fits.csv`` per
-variant); this module only tabulates them, so that the table job needs neither the
-simulation nor the pulse fits.
+The fits come from :func:`chain.studies.ablation.run_variants` (the ablation job's
+``fits.csv``, as written); this module only tabulates them.
 """
 
 from __future__ import annotations
@@ -29,8 +28,8 @@ def ablation_table(fits: Mapping[str, pd.DataFrame], overrides: Mapping[str, str
     Parameters
     ----------
     fits : mapping
-        Variant name -> its fits (:func:`chain.studies.ablation.variant_fits` rows with a
-        ``replicate`` column; replicate 0 is the run's seed).
+        Variant name -> its fits (:func:`chain.studies.ablation.run_variants` rows with
+        ``estimator`` and ``replicate``; replicate 0 is the run's seed).
     overrides : mapping
         Variant name -> its overrides as text (for the ``overrides`` column).
 

@@ -54,33 +54,3 @@ def analyse_per_estimator(
         delay_fits.append(delays.assign(estimator=estimator))
         ssw_fits.append(ssw.assign(estimator=estimator))
     return pd.concat(delay_fits, ignore_index=True), pd.concat(ssw_fits, ignore_index=True)
-
-
-def variant_ssw_fits(
-    traces: Sequence[pd.DataFrame],
-    pulses: pd.DataFrame,
-    selection: pd.DataFrame | None,
-    estimator: str,
-) -> pd.DataFrame:
-    """SSW = slope x F_m at S2 (behind LSTW) of an ablation variant's shots
-    (:func:`chain.studies.ablation.run_variant_shots`), the same shot selection.
-
-    Parameters
-    ----------
-    traces : sequence of DataFrame
-        The trace table of each chain.
-    pulses : DataFrame
-        Their pulse rows.
-    selection : DataFrame or None
-        The shot selection; None keeps every shot.
-    estimator : str
-        Pulse estimator.
-    """
-    ssw = pd.concat(
-        [
-            ssw_table(t, pulses[pulses["N"] == t["N"].iloc[0]], selection, estimator=estimator)
-            for t in traces
-        ],
-        ignore_index=True,
-    )
-    return ssw_fit_table(ssw[ssw["sensor"] == "S2"])

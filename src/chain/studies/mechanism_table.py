@@ -21,7 +21,6 @@ MECHANISM_COLUMNS = tuple(
 )
 
 
-
 def mechanism_rows(
     mechanism: str,
     settings: Mapping[str, str],
@@ -80,8 +79,8 @@ def mechanism_rows(
 
 def candidate_rows(
     candidates: Mapping[str, tuple[str, str]],
-    delay_fits: Mapping[str, pd.DataFrame],
-    ssw_fits: Mapping[str, pd.DataFrame],
+    delay_fits: pd.DataFrame,
+    ssw_fits: pd.DataFrame,
     reference: str,
 ) -> pd.DataFrame:
     """Rows of ``ssw_mechanisms.csv`` for the virtual-experiment candidates (ablation
@@ -91,8 +90,9 @@ def candidate_rows(
     ----------
     candidates : mapping
         Variant name -> (mechanism, setting label); the reference may be absent.
-    delay_fits, ssw_fits : mapping
-        Variant name -> its ``_fits.csv`` and ``_ssw_fits.csv`` (replicate 0 is used).
+    delay_fits, ssw_fits : DataFrame
+        The ablation variants' delay fits and SSW fits
+        (:func:`chain.studies.ablation.run_variants`; replicate 0 is used).
     reference : str
         Name of the reference variant (the run's virtual experiment).
 
@@ -104,17 +104,15 @@ def candidate_rows(
     """
 
     def first(table: pd.DataFrame, name: str) -> pd.DataFrame:
-        if "replicate" in table:
-            table = table[table["replicate"] == 0]
-        return table.assign(model=name)
+        return table[(table["variant"] == name) & (table["replicate"] == 0)].assign(model=name)
 
     groups = {REFERENCE_MECHANISM: {reference: "as configured"}}
     for name, (mechanism, label) in candidates.items():
         if name != reference:
             groups.setdefault(mechanism, {})[name] = label
     names = [reference, *(n for n in candidates if n != reference)]
-    delays = [first(delay_fits[n], n) for n in names]
-    ssw = [first(ssw_fits[n], n) for n in names]
+    delays = [first(delay_fits, n) for n in names]
+    ssw = [first(ssw_fits, n) for n in names]
     tables = [
         mechanism_rows(mechanism, settings, delays, ssw, reference)
         for mechanism, settings in groups.items()

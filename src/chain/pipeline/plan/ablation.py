@@ -1,20 +1,18 @@
 """The ablation study's facts (the virtual experiment, a MODEL, not data): its variants
-(:mod:`chain.pipeline.config.ablation`), which of them the run makes, each variant's
-settings and tolerance, the replicates that read the run's own virtual experiment,
-and the variants whose settings repeat an earlier one's (twins: one job for both)."""
+(:mod:`chain.pipeline.config.ablation`), which of them the run makes (its ablation tables'
+and the mechanism study's candidates), each variant's settings and tolerance."""
 
 from __future__ import annotations
 
-import json
 from functools import cached_property
 
 from chain.pipeline.config.ablation import ablation_variants, variant_settings, variant_tolerance
 from chain.studies.ablation_table import overrides_text
-from chain.studies.mechanism_settings import CANDIDATE_REFERENCE
+from chain.studies.mechanism_settings import CANDIDATE_REFERENCE, candidate_variants
 
 
 class AblationPlan:
-    """The facts of the ablation_variant and ablation_table jobs.
+    """The facts of the ablation_variants job.
 
     Parameters
     ----------
@@ -50,6 +48,23 @@ class AblationPlan:
             if v["default_run"] and not v["mechanism"] and name != CANDIDATE_REFERENCE
         ]
 
+    def candidates(self, full: bool) -> dict[str, list[str]]:
+        """Variant -> [mechanism, setting] of the mechanism study's candidates
+        (:func:`chain.studies.mechanism_settings.candidate_variants`); none unless the
+        experiment is virtual and ``studies.mechanisms`` on."""
+        if not (self.plan.experiment.virtual and self.plan.study("mechanisms")):
+            return {}
+        found = candidate_variants(list(self.variants.values()), full)
+        return {name: list(pair) for name, pair in found.items()}
+
+    @property
+    def made(self) -> list[str]:
+        """The variants the run makes, in config order: its ablation tables' and the
+        mechanism study's candidates (every one with ``studies.mechanisms: full``)."""
+        every = self.plan.config["studies"]["mechanisms"] == "full"
+        wanted = {*self.names(False), *self.candidates(every)}
+        return [name for name in self.variants if self.full or name in wanted]
+
     def settings(self, name: str) -> list[list[dict]]:
         """Per replicate, the VirtualExperiment fields of every chain of one variant."""
         variant, config = self.variants[name], self.plan.config
@@ -62,27 +77,21 @@ class AblationPlan:
         """Acceptance tolerance of a variant; None keeps every collision shot."""
         return variant_tolerance(self.plan.config, self.variants[name])
 
-    def reads_run(self, name: str) -> list[bool]:
-        """Per replicate of a variant, whether its settings are the run's virtual
-        experiment's for every chain: its shots are then that experiment's files, byte
-        for byte, which the job reads instead of simulating them again."""
-        experiment = self.plan.experiment
-        run = [experiment.settings(n) for n in self.plan.chains] if experiment.virtual else None
-        return [chains == run for chains in self.settings(name)]
+    def job(self) -> dict[str, dict]:
+        """Variant -> {settings: :meth:`settings`; tolerance: :meth:`tolerance`; ssw:
+        whether its SSW is fitted (a candidate's)} of :attr:`made`."""
+        candidates = self.candidates(self.plan.config["studies"]["mechanisms"] == "full")
+        return {
+            name: {"settings": self.settings(name), "tolerance": self.tolerance(name),
+                   "ssw": name in candidates}
+            for name in self.made
+        }  # fmt: skip
 
-    @cached_property
-    def _firsts(self) -> dict[str, str]:
-        first: dict[str, str] = {}
-        for name in self.variants:
-            key = json.dumps([self.settings(name), self.tolerance(name)])
-            first.setdefault(key, name)
-            first[name] = first[key]
-        return {name: first[name] for name in self.variants}
-
-    def job(self, name: str) -> str:
-        """The variant whose job makes ``name``'s outputs: the first variant listed with
-        the same settings (every replicate) and tolerance, itself if none."""
-        return self._firsts[name]
+    @property
+    def run(self) -> list[dict]:
+        """The run's virtual experiment of every chain (its fields), whose shots the
+        variants share."""
+        return [self.plan.experiment.settings(n) for n in self.plan.chains]
 
     @property
     def overrides(self) -> dict[str, str]:

