@@ -1,12 +1,10 @@
-# The ablation study (the virtual experiment, a MODEL, not data): one job reruns the
-# virtual experiment of every chain for each variant the run makes (ablation.variants:
-# the default run's, with the mechanism study's candidates; studies.ablation: full, all),
-# with one ingredient changed (chain.studies.ablation), in memory; each distinct launch is
-# integrated once, and the shots that are the run's virtual experiment's are read from
-# its datasets. It analyses them with the main estimator as the pipeline analyses the
-# experiment, fits C and a free exponent, and tabulates the default run's variants
-# (tables/ablation_exponent.csv) and, with studies.ablation: full, every variant
-# (tables/ablation_exponent_all.csv). A job: a few seconds of work, a second of start-up.
+# The ablation study (the virtual experiment, a MODEL, not data): one job (a few seconds
+# of work behind a second of start-up) reruns, in memory, the virtual experiment of every
+# chain with each variant's ingredient changed (ablation.variants: the default run's and
+# the mechanism study's candidates; with studies.ablation: full, all), each distinct
+# launch integrated once and the shots that are the run's read from its datasets;
+# analyses them with the main estimator, fits C and a free exponent, and tabulates
+# tables/ablation_exponent.csv (and, full, tables/ablation_exponent_all.csv).
 
 from chain.pipeline.plan.ablation import AblationPlan
 
@@ -34,7 +32,7 @@ rule ablation_variants:
         runtime=30,  # minutes
     params:
         variants=lambda w: ABLATION.job(),
-        run=lambda w: ABLATION.run,
+        run=lambda w: [PLAN.experiment.settings(n) for n in PLAN.chains],
         estimator=config["analysis"]["main_estimator"],
         series=PLAN.experiment.series,
         table=lambda w: ABLATION.names(full=False),

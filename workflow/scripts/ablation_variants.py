@@ -1,7 +1,6 @@
-"""Every ablation variant the run makes (params variants), all its replicates, in memory:
-delay fits and SSW fits at S2 with the run's main estimator (chain.studies.ablation),
-the shots that are the run's virtual experiment's read from its datasets; then the
-ablation tables (chain.studies.ablation_table) from the fits as written."""
+"""Every ablation variant the run makes, in memory: delay fits and SSW fits with the
+main estimator (chain.studies.ablation), the shots that are the run's virtual
+experiment's read from its datasets; the tables from the fits as written."""
 
 import pandas as pd
 from _logging import done, start

@@ -115,12 +115,11 @@ _LAUNCH_DRAWS |= {"right_speed_offset", "right_delay_s"}
 
 def _shots_of(settings: VirtualExperiment, plan: pd.DataFrame, other) -> np.ndarray:
     """Which shots of ``plan`` (of ``settings``) are the shots of the virtual experiment
-    ``other`` to the bit: the settings, with a set time step, differ at most in
+    ``other`` (or None) to the bit: the settings, with a set time step, differ at most in
     :data:`_LAUNCH_DRAWS`, and the shot's launch and sampling phase are its."""
-    mine, theirs = asdict(settings), asdict(other)
-    if settings.time_step_s is None or any(
-        mine[key] != theirs[key] for key in mine if key not in _LAUNCH_DRAWS
-    ):
+    mine, theirs = asdict(settings), asdict(other) if other else {}
+    differ = {key for key in mine if key not in _LAUNCH_DRAWS and mine[key] != theirs.get(key)}
+    if differ or settings.time_step_s is None:
         return np.zeros(len(plan), dtype=bool)
     columns = ["kind", "v_left_m_s", "v_right_m_s", "delay_s", "sampling_phase_s"]
     return (plan[columns] == plan_shots(other)[columns]).all(axis=1).to_numpy()
@@ -145,16 +144,13 @@ def virtual_traces(
     known : dict, optional
         Launches integrated already (:func:`simulate_virtual_shots`), filled here.
     run : (VirtualExperiment, path), optional
-        Another virtual experiment and its dataset folder (the run's): the shots that
-        are its shots to the bit are read from its files instead of integrated again.
+        Another virtual experiment and its dataset folder: its shots read from its files.
     """
     rng = np.random.default_rng(settings.seed)
     plan = _plan(settings, rng)
-    read = np.zeros(len(plan), dtype=bool) if run is None else _shots_of(settings, plan, run[0])
-    time, integrated = None, iter(())
-    if not read.all():
-        time, forces = simulate_virtual_shots(settings, plan, known, wanted=~read)
-        integrated = iter(forces)
+    read = _shots_of(settings, plan, run and run[0])
+    shots = simulate_virtual_shots(settings, plan, known, ~read) if (~read).any() else (None, [])
+    time, integrated = shots[0], iter(shots[1])
     meta = parse_metadata(_metadata(settings, plan, dataset_name))
     tables, saturated = [], np.zeros(len(plan), dtype=bool)
     for i, shot in enumerate(plan.itertuples(index=False)):

@@ -157,10 +157,9 @@ def simulate_virtual_shots(
     known: dict | None = None,
     wanted: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Integrate the shots of ``plan`` (from :func:`plan_shots`) with the apparatus model:
-    (simulated fine time (S,) s from the first impact, sensor readings (B, n_sensors, S)
-    N of every shot of ``plan``, or of the ``wanted`` ones (bool (len(plan),)), in plan
-    order).
+    """Integrate the shots of ``plan`` (from :func:`plan_shots`), or the ``wanted`` ones
+    (bool (len(plan),)), with the apparatus model: (simulated fine time (S,) s from the
+    first impact, their sensor readings (B, n_sensors, S) N, in plan order).
 
     Collision shots use a chain with both strikers, reference shots one with the left
     striker only, both with the same time step (from the fastest shot of ``plan``); each

@@ -54,8 +54,7 @@ def variant_fits(
         selection = select_shots(pulses, tolerance, estimator=estimator)
     if not ssw:
         return fit_pulses(pulses, selection), None
-    # Read at S2 only: without S1's crossed pulses, S1's rows are empty ones, at no cost.
-    at_s2 = pulses[(pulses["sensor"] != "S1") | (pulses["role"] != "crossed")]
+    at_s2 = pulses[(pulses["sensor"] != "S1") | (pulses["role"] != "crossed")]  # S1 rows: empty
     rows = pd.concat(
         [ssw_table(t, at_s2[at_s2["N"] == t["N"].iloc[0]], selection, estimator=estimator)
          for t in traces],
@@ -99,10 +98,8 @@ def run_variants(
         for replicate, chains in enumerate(variant["settings"]):
             key = json.dumps([chains, tolerance, fit_ssw])
             if key not in analysed:
-                traces = [
-                    virtual_traces(VirtualExperiment.from_dict(c), series, known, run=r)
-                    for c, r in zip(chains, runs, strict=True)
-                ]
+                shots = [VirtualExperiment.from_dict(c) for c in chains]
+                traces = [virtual_traces(s, series, known, r) for s, r in zip(shots, runs)]
                 analysed[key] = variant_fits(traces, tolerance, estimator, fit_ssw)
             delays, ssw = analysed[key]
             pooled = delays[delays["N"].astype(str) == "pooled"].iloc[0]

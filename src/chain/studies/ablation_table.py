@@ -1,10 +1,6 @@
 """The ablation table (``tables/ablation_exponent.csv``): C and the free exponent of
 every variant of the virtual experiment, at the run's seed and over the seeds of its
-replicates.
-
-The fits come from :func:`chain.studies.ablation.run_variants` (the ablation job's
-``fits.csv``, as written); this module only tabulates them.
-"""
+replicates, tabulated from their fits (:func:`chain.studies.ablation.run_variants`)."""
 
 from __future__ import annotations
 

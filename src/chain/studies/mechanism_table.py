@@ -91,8 +91,7 @@ def candidate_rows(
     candidates : mapping
         Variant name -> (mechanism, setting label); the reference may be absent.
     delay_fits, ssw_fits : DataFrame
-        The ablation variants' delay fits and SSW fits
-        (:func:`chain.studies.ablation.run_variants`; replicate 0 is used).
+        :func:`chain.studies.ablation.run_variants`'s, of every variant (replicate 0 used).
     reference : str
         Name of the reference variant (the run's virtual experiment).
 

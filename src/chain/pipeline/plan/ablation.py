@@ -88,12 +88,6 @@ class AblationPlan:
         }  # fmt: skip
 
     @property
-    def run(self) -> list[dict]:
-        """The run's virtual experiment of every chain (its fields), whose shots the
-        variants share."""
-        return [self.plan.experiment.settings(n) for n in self.plan.chains]
-
-    @property
     def overrides(self) -> dict[str, str]:
         """Variant -> what it changes, in words (a column of the table)."""
         return {name: overrides_text(v) for name, v in self.variants.items()}
