@@ -97,7 +97,7 @@ for path, rule, name in [
 # One job copies the run's files from the store into the run folder, each checked
 # against the digest stored with it, with the logs and benchmarks of every job they
 # come from; SHA256SUMS last. On the machine that runs Snakemake: a copy is not worth a
-# batch job.
+# batch job. Its own log is beside the run folder: it is written after SHA256SUMS.
 rule run_folder:
     input:
         lambda w: [
@@ -107,7 +107,7 @@ rule run_folder:
         [f"{OUT}/{path}" for path in RUN_FOLDER],
         sums=f"{OUT}/SHA256SUMS",
     log:
-        f"{OUT}/logs/run_folder.log",
+        f"results/.logs/{PLAN.run_name}/run_folder.log",
     localrule: True
     conda:
         ENV
