@@ -60,7 +60,8 @@ rule summary:
 
 rule article:
     input:
-        source=CHECKOUT / "workflow" / "report" / "article.typ",
+        # Relative to the working directory: a copied checkout names the same input.
+        source=os.path.relpath(CHECKOUT / "workflow" / "report" / "article.typ"),
         summary=made("summary", "json"),
         delays=made("delay_fits", "delays"),
         ssw=made("ssw", "ssw"),
