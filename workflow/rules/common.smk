@@ -1,5 +1,5 @@
 # What every rule file shares. The config's check and plan; the result store, where a
-# computing rule writes in a folder named by its recipe's key (stored(): a recipe an
+# computing rule writes in a folder named by its recipe's key (stored(); a recipe an
 # earlier run computed is found there, and Snakemake starts nothing for it); how one rule
 # names another's outputs (made(), output_of()); what the run folder shows (publish()).
 # docs/architecture.md, docs/store.md.
