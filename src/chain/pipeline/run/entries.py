@@ -154,21 +154,25 @@ def seal(outputs: Iterable[str], sums: str, inputs: dict[str, str]) -> None:
 
 def entry_problem(entry: Path) -> str | None:
     """What is wrong with a sealed entry, if anything: a listed file missing, not a
-    regular file, writable, or changed after the seal (newer than its SHA256SUMS).
-    An entry not sealed yet (its job running, or killed) is Snakemake's to judge."""
+    regular file, writable, or changed after the seal (newer than its SHA256SUMS, and
+    its bytes no longer the listed ones: a file touched is Snakemake's newer input, and
+    it reruns what reads it). An entry not sealed yet (its job running, or killed) is
+    Snakemake's to judge."""
     try:
         sealed = os.lstat(entry / SUMS).st_mtime_ns
-        names = [name for name in read_sums(entry) if not name.startswith("../")]
+        listed = {n: d for n, d in read_sums(entry).items() if not n.startswith("../")}
     except (OSError, UnicodeDecodeError):
         return None if not (entry / SUMS).exists() else f"{SUMS} unreadable"
-    for name in names:
+    for name, digest in listed.items():
         try:
             info = os.lstat(entry / name)
         except OSError:
             return f"{name} missing"
         if not stat.S_ISREG(info.st_mode):
             return f"{name} is not a regular file"
-        if info.st_mode & 0o222 or info.st_mtime_ns > sealed:
+        if info.st_mode & 0o222 or (
+            info.st_mtime_ns > sealed and file_digest(entry / name) != digest
+        ):
             return f"{name} was changed after it was stored"
     return None
 
