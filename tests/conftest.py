@@ -521,9 +521,12 @@ def copy_library(compiled_kernels) -> Callable[[Path], dict]:
 
 def library_env(folder: Path) -> dict:
     """The environment of a Snakemake run whose jobs import the library copied by
-    :func:`copy_library` into ``folder``: on ``PYTHONPATH``, numba's kernels in-tree."""
+    :func:`copy_library` into ``folder``: on ``PYTHONPATH``, numba's kernels in-tree,
+    the result store the work tree's own (``results/.store``, whatever
+    ``HERTZCHAIN_STORE`` says outside the tests)."""
     env = {**os.environ, "PYTHONPATH": str(folder)}
-    env.pop("NUMBA_CACHE_DIR", None)
+    for name in ("NUMBA_CACHE_DIR", "HERTZCHAIN_STORE", "HERTZCHAIN_STORE_GROUP"):
+        env.pop(name, None)
     return env
 
 
