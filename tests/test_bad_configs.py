@@ -107,6 +107,9 @@ BAD_CONFIGS = [
     (("studies", "ablation"), "yes"),
     (("studies", "mechanisms"), 1),
     (("studies", "c_sensitivity"), None),
+    # Shorter than 26 beads, an elastic chain's SSW never separates from the main wave.
+    (("long_chains", "N", 0), 3),
+    (("long_chains", "N", 1), 25),
 ]
 
 

@@ -4,11 +4,13 @@ are in test_bad_configs.py and test_bad_datasets.py through the same library che
 Each run uses an overlay in a temporary folder with its own run_name, in this checkout
 (the checks stop Snakemake while it parses the Snakefile, before it locks or writes):
 the console (Snakemake's stderr) must name the key or file, and results/<run>/ must not
-exist afterwards.
+exist afterwards. A run of the tiny config in a folder of its own shows that a bad
+config writes nothing at all there: no run folder, no store.
 """
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -18,6 +20,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "tests" / "data" / "virtual_small"
+TINY = ROOT / "tests" / "configs" / "tiny.yaml"
 
 pytestmark = pytest.mark.workflow
 
@@ -31,6 +34,7 @@ def run(tmp_path: Path, name: str, overlay: str, *args: str) -> tuple[int, str]:
         capture_output=True,
         text=True,
         timeout=600,
+        stdin=subprocess.DEVNULL,
     )
     assert not (ROOT / "results" / name).exists(), f"results/{name}/ was written"
     return result.returncode, result.stdout + result.stderr
@@ -69,3 +73,26 @@ def test_overlay_with_a_repeated_key_names_file_and_line(tmp_path):
     assert status != 0
     assert f"{tmp_path}/bad_repeat.yaml line 3" in console
     assert "'seed' is given twice" in console
+
+
+@pytest.mark.parametrize("args", [("--dry-run",), ()], ids=["dry-run", "real run"])
+def test_a_chain_too_short_for_the_long_chains_stops_before_any_job(tmp_path, args):
+    """``long_chains: {N: [3]}`` over the tiny config, in a working folder of its own:
+    the console names the key and its bound (26, the shortest elastic chain whose SSW
+    separates), no job is started or planned, and nothing is written: no run folder,
+    no store."""
+    work = tmp_path / "work"
+    work.mkdir()
+    overlay = tmp_path / "short.yaml"
+    overlay.write_text("run_name: short\nlong_chains: {N: [3]}\n")
+    configs = [str(ROOT / "config.yaml"), str(TINY), str(overlay)]
+    result = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--snakefile", str(ROOT / "Snakefile"),
+         "--directory", str(work), "--cores", "1", "--configfile", *configs, *args],
+        cwd=work, capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL,
+    )  # fmt: skip
+    console = result.stdout + result.stderr
+    assert result.returncode != 0, console[-3000:]
+    assert "long_chains" in console and "26" in console, console[-3000:]
+    assert not re.search(r"^(?:local)?rule \w+:$", console, re.M), console[-3000:]
+    assert not (work / "results").exists()
