@@ -226,21 +226,81 @@ def test_another_release_is_left_as_it_is_and_said_so_in_one_line():
     assert (ROOT / "docs" / "upstream" / "README.md").is_file()
 
 
-def test_the_workflow_attributes_reuse_reads_are_the_locked_snakemakes():
-    """The store's part before the first job (common.smk's prepare_run) reads public
-    attributes of Snakemake's workflow object: whether this process runs the workflow,
-    whether it is a dry run or --touch, and the DAG settings (targets, --forceall ...)."""
+#: The public names of Snakemake's workflow object that the Snakefile and common.smk
+#: read while Snakemake reads them (the workflow, and rules.<name> of a rule).
+WORKFLOW_NAMES = (
+    "dryrun", "touch", "is_main_process", "current_basedir", "overwrite_configfiles",
+    "output_settings",
+)  # fmt: skip
+
+#: A workflow that prints what common.smk reads, while Snakemake reads the Snakefile.
+PROBE = """\
+import json, sys
+
+rule a:
+    input:
+        named=lambda w: "in.txt",
+    output:
+        out="out.txt",
+    params:
+        p=lambda w: 1,
+    script:
+        "s.py"
+
+proxy = rules.a
+print("PROBE " + json.dumps({
+    "dryrun": workflow.dryrun,
+    "touch": workflow.touch,
+    "is_main_process": workflow.is_main_process,
+    "current_basedir": str(workflow.current_basedir),
+    "overwrite_configfiles": [str(p) for p in workflow.overwrite_configfiles],
+    "output_dryrun": workflow.output_settings.dryrun,
+    "input": sorted(proxy.input.keys()),
+    "params": sorted(proxy.params.keys()),
+    "output": [str(proxy.output["out"]), [str(p) for p in proxy.output]],
+    "script": proxy.rule.script,
+}), file=sys.stderr)
+"""
+
+
+@pytest.mark.parametrize("dry", [False, True], ids=["run", "dry-run"])
+def test_the_workflow_names_common_reads_are_public_on_the_locked_snakemake(tmp_path, dry):
+    """The names the workflow reads of Snakemake while it reads the Snakefile are public
+    attributes of the locked release (no ``_``), and say what common.smk takes them for:
+    a dry run is told by its output settings there (``workflow.dryrun`` is set only
+    once the Snakefile is read), rules.<name> gives a rule's named inputs, params and
+    outputs and its script."""
+    import json
+    import subprocess
+    import sys
+
     import snakemake.api  # noqa: F401 (snakemake.workflow imports itself through it)
-    from snakemake.settings.types import DAGSettings
+    from snakemake.rules import Rule, RuleProxy
+    from snakemake.settings.types import OutputSettings
     from snakemake.workflow import Workflow
 
-    for name in ("is_main_process", "executor_plugin", "dryrun", "touch"):
-        assert isinstance(inspect.getattr_static(Workflow, name), property), name
-    assert "self.dag_settings" in inspect.getsource(Workflow)
-    for field in ("targets", "forceall", "forcerun", "forcetargets"):
-        assert field in DAGSettings.__dataclass_fields__, field
-    # The DAG is built, and the input functions called, only after the executor is set.
-    execute = inspect.getsource(Workflow.execute)
-    assert execute.index("self._executor_plugin = executor_plugin") < execute.index(
-        "self._build_dag()"
-    )
+    assert all(hasattr(Workflow, name) for name in WORKFLOW_NAMES)
+    assert "output_settings" in Workflow.__dataclass_fields__
+    assert "dryrun" in OutputSettings.__dataclass_fields__
+    assert {"input", "output", "params"} <= set(vars(RuleProxy))
+    assert "self.rule = rule" in inspect.getsource(RuleProxy.__init__)
+    assert "self.script" in inspect.getsource(Rule.__init__)
+
+    (tmp_path / "Snakefile").write_text(PROBE)
+    config = tmp_path / "extra.yaml"
+    config.write_text("x: 1\n")
+    args = ["--cores", "1", "--configfile", str(config), *(["-n"] if dry else [])]
+    result = subprocess.run(
+        [sys.executable, "-m", "snakemake", *args],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300, stdin=subprocess.DEVNULL,
+    )  # fmt: skip
+    (line,) = [line for line in result.stderr.splitlines() if line.startswith("PROBE ")]
+    seen = json.loads(line.removeprefix("PROBE "))
+    assert seen["output_dryrun"] is dry
+    assert seen["dryrun"] is False and seen["touch"] is False  # not set yet while parsing
+    assert seen["is_main_process"] is True
+    assert Path(seen["current_basedir"]) == tmp_path
+    assert [Path(p).name for p in seen["overwrite_configfiles"]] == ["extra.yaml"]
+    assert seen["input"] == ["named"] and seen["params"] == ["p"]
+    assert seen["output"] == ["out.txt", ["out.txt"]]
+    assert seen["script"] == "s.py"
