@@ -115,7 +115,8 @@ class Recipes:
             if problem:
                 if discard_damaged:
                     discard(entry)
-                then = "discarded: computed anew" if discard_damaged else "a run computes it anew"
+                then = "discarded" if discard_damaged else "a run discards it"
+                then += ", and a job that needs it computes it anew"
                 lines.append(f"hertzchain: stored result {entry} is damaged ({problem}); {then}")
         return lines
 
