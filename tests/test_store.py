@@ -265,10 +265,11 @@ def test_check_entries_discards_only_damaged_entries_and_a_dry_run_nothing(chain
     os.chmod(use / "b.csv", 0o644)
     recipes = Recipes(str(store))
     damaged = f"hertzchain: stored result {use} is damaged (b.csv was changed after it was stored)"
-    assert recipes.check_entries(discard_damaged=False) == [f"{damaged}; a run computes it anew"]
+    then = ", and a job that needs it computes it anew"
+    assert recipes.check_entries(discard_damaged=False) == [f"{damaged}; a run discards it{then}"]
     assert use.exists()
     (line,) = recipes.check_entries(discard_damaged=True)
-    assert line.endswith("; discarded: computed anew")
+    assert line.endswith(f"; discarded{then}")
     assert sorted(p.name for p in store.iterdir()) == sorted([MAKE, f"half-{K3}", "notes"])
     assert Recipes(str(store / "none")).check_entries(True) == []
 
