@@ -313,11 +313,12 @@ def fresh() -> None:
     recipe._source_digest.cache_clear()
 
 
-def key_of(rule="make", params=None, inputs=None, outputs=("a.csv", SUMS)) -> str:
+def key_of(rule="make", params=None, inputs=None, outputs=("a.csv", SUMS), wildcards=None):
     fresh()
     params = {"scale": 1, "speeds": [0.1, 0.2]} if params is None else params
     inputs = INPUTS if inputs is None else inputs
-    return Recipes(STORE).key(rule, Path("workflow/scripts/job.py"), params, inputs, list(outputs))
+    script = Path("workflow/scripts/job.py")
+    return Recipes(STORE).key(rule, wildcards or {}, script, params, inputs, list(outputs))
 
 
 def edited(name: str, text: str, **recipe) -> str:
@@ -331,7 +332,7 @@ def edited(name: str, text: str, **recipe) -> str:
 
 
 def test_a_key_changes_with_every_part_of_the_recipe(checkout, monkeypatch):
-    """32 hex digits, changed by the rule, a param, an upstream job's key (in the path
+    """32 hex digits, changed by the rule, a wildcard, a param, an upstream job's key (in the path
     of its stored output), the output names, a source file's bytes or a file of a source
     folder, the script, its local helper, a chain module it imports, a chain module a
     param names ("chain.named:summary") and only then, and an installed version."""
@@ -340,6 +341,7 @@ def test_a_key_changes_with_every_part_of_the_recipe(checkout, monkeypatch):
     named = {"scale": 1, "speeds": [0.1, 0.2], "summarise": "chain.named:summary"}
     changed = {
         "rule": key_of(rule="other"),
+        "wildcard": key_of(wildcards={"setting": "mut030-mub000"}),
         "param": key_of(params={"scale": 1, "speeds": [0.1, 0.3]}),
         "upstream key": key_of(inputs={**INPUTS, "table": f"{STORE}/make-{K3}/a.csv"}),
         "outputs": key_of(outputs=["b.csv", SUMS]),

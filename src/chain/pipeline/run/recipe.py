@@ -1,7 +1,7 @@
 """The key of a job's recipe, which names its folder in the result store.
 
 A job's key is the SHA-256 of what determines its outputs, known before any job runs:
-its rule; the code its script runs (the script, its local helpers and every module of
+its rule and wildcards; the code its script runs (the script, its local helpers and every module of
 the ``chain`` package it imports, :mod:`chain.pipeline.plan.code`); its params; each
 input, as the path of another job's stored output (whose folder carries that job's key,
 so keys chain down to the sources) or the SHA-256 of a file no job makes; its output
@@ -66,13 +66,16 @@ class Recipes:
         self.store = os.path.normpath(store)
         self._software: dict[str, str] | None = None
 
-    def key(self, rule: str, script: Path, params: dict, inputs: dict, outputs: list) -> str:
+    def key(self, rule: str, wildcards: dict, script: Path, params: dict, inputs: dict,
+            outputs: list) -> str:  # fmt: skip
         """The key (:data:`KEY_DIGITS` hex digits) of one job's recipe.
 
         Parameters
         ----------
         rule : str
             The rule's name.
+        wildcards : dict
+            The job's wildcard values (a script may read them).
         script : Path
             The script the rule runs.
         params, inputs : dict
@@ -88,6 +91,7 @@ class Recipes:
                   for name, v in inputs.items()}  # fmt: skip
         recipe = {
             "rule": rule,
+            "wildcards": wildcards,
             "code": code_digest(Path(script).resolve(), named),
             "params": params,
             "inputs": tokens,
