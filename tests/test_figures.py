@@ -482,6 +482,20 @@ def test_fig5_panel_b_from_the_track():
     assert [line.get_xdata()[0] for line in dotted] == [4.0]
 
 
+def test_fig5_panel_b_says_so_when_no_chain_separates_an_ssw(tmp_path):
+    """Chains too short for the SSW to separate (none separated): panel (b) is drawn,
+    saying so, instead of failing on an empty log axis."""
+    ssw, fits = ssw_tables()
+    track = pd.DataFrame(
+        {"model": "elastic", "N": 16, "wave": "LSTW", "distance_beads": [3.0, 4.0],
+         "force_N": np.nan, "F_m_N": 100.0, "separated": False}
+    )  # fmt: skip
+    fig = fig5_ssw_vs_force(ssw, fits, track, None, sensor_distances={16: 3.5})
+    fig.savefig(tmp_path / "fig5.png")
+    texts = [t.get_text() for t in fig.get_axes()[1].texts]
+    assert texts == ["no separated SSW on any chain of this run"]
+
+
 def test_parity_figure():
     rows = [
         {

@@ -201,6 +201,10 @@ def draw_ssw_vs_distance(ax, track: pd.DataFrame, speed=None, sensor_distances=N
         ax.plot([], [], color=SENSOR_COLOR, lw=2.5, alpha=0.5, label=f"paper's sensors: {chains}")
     _draw_separation(ax, speed, colors)
     ax.set_yscale("log")
+    if not rows["separated"].astype(bool).any():  # an empty log axis needs its own limits
+        ax.set_ylim(1e-3, 1e-1)
+        ax.text(0.5, 0.5, "no separated SSW on any chain of this run", transform=ax.transAxes,
+                ha="center", va="center", fontsize=7, color="0.3")  # fmt: skip
     ax.set_xlabel("distance from the collision point (beads)")
     ax.set_ylabel("SSW amplitude / F$_m$ (separated)")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=5.5, frameon=False,
