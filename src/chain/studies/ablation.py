@@ -102,13 +102,9 @@ def run_variants(
                 traces = [virtual_traces(s, series, known, r) for s, r in zip(shots, runs)]
                 analysed[key] = variant_fits(traces, tolerance, estimator, fit_ssw)
             delays, ssw = analysed[key]
-            pooled = delays[delays["N"].astype(str) == "pooled"].iloc[0]
             seeds = " ".join(str(c["seed"]) for c in chains)
-            log.info(
-                "%s replicate %d (seeds %s), %s: C = %.2f +- %.2f us N^1/6, exponent %.4f +- %.4f",
-                *(name, replicate, seeds, estimator),
-                *pooled[["C_us_N16", "C_stderr_us_N16", "exponent", "exponent_stderr"]],
-            )
+            rows = delays[["N", "C_us_N16", "C_stderr_us_N16", "exponent", "exponent_stderr"]]
+            log.info("%s replicate %d (seeds %s), %s:\n%s", name, replicate, seeds, estimator, rows)
             tags = {"estimator": estimator, "replicate": replicate}
             for rows, table in ((delays.assign(**tags, seeds=seeds), fits), (ssw, ssw_fits)):
                 if rows is not None:
