@@ -1,14 +1,13 @@
 """What a computed job pays before its first line of work, step by step, in fresh
 interpreters: the interpreter itself, Snakemake's script preamble (it unpickles the
 job's ``snakemake`` object and imports Snakemake's logging and containers), then the
-script's own imports; and, for the commit that looked each job's result up from inside
-the job (:data:`HOOKED`), what that lookup added (its imports, the package versions of
-the key, the SHA-256 of the job's inputs).
+script's own imports (``_logging`` among them: the store's check of the job's inputs
+and its seal, chain.pipeline.run.entries).
 
 Run from the repository root::
 
     python benchmarks/bench_job_startup.py                 # best of 5 rounds
-    python benchmarks/bench_job_startup.py --rounds 9 --scripts delays summary_md
+    python benchmarks/bench_job_startup.py --rounds 9 --scripts delay_fits summary
 
 Each round starts every measurement once, interleaved; the best (least) wall time of
 the rounds is kept, and the load average printed before and after. CPU-bound and
@@ -22,7 +21,6 @@ import ast
 import pickle
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -30,26 +28,14 @@ from measure import Conditions, Figure, OtherProcesses, write_result
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = ROOT / "workflow" / "scripts"
-#: The commit whose jobs each looked their result up before computing.
-HOOKED = "446fd34"
-#: A job of each kind: a small table, text, a figure, a simulation.
-DEFAULT_SCRIPTS = ("delays", "summary_md", "fig4_delay_vs_force", "simulate")
+#: A job of each kind: a small table, the summary, a figure, a simulation.
+DEFAULT_SCRIPTS = ("delay_fits", "summary", "fig4_delay_vs_force", "simulate")
 
 #: Snakemake's preamble, as ``snakemake.script.PythonScript`` writes it (9.27).
 PREAMBLE = (
     "import sys; import pickle; snakemake = pickle.loads({payload!r}); "
     "from snakemake.logging import logger; from snakemake.iocontainers import Snakemake\n"
 )
-
-#: What the hooked commit's first import did before the script (its store lookup).
-HOOK = """
-import sys
-sys.path.insert(0, {src!r})
-from chain.pipeline.reuse import software_versions
-from chain.pipeline.store import file_digest
-software_versions()
-[file_digest(p) for p in {inputs!r}]
-"""
 
 
 def payload() -> bytes:
@@ -59,7 +45,7 @@ def payload() -> bytes:
     inputs = io.InputFiles([f"results/paper/tables/t{i}.csv" for i in range(30)])
     job = io.Snakemake(inputs, io.OutputFiles(["results/paper/tables/out.csv"]), io.Params(),
                        io.Wildcards(), 1, io.ResourceList(), io.Log(["x.log"]),
-                       {"run_name": "paper"}, "delays", 0, str(SCRIPTS))  # fmt: skip
+                       {"run_name": "paper"}, "delay_fits", 0, str(SCRIPTS))  # fmt: skip
     return pickle.dumps(job, protocol=4)
 
 
@@ -70,15 +56,12 @@ def script_imports(script: Path) -> str:
     return f"import sys; sys.path.insert(0, {str(script.parent)!r})\n" + "\n".join(lines)
 
 
-def commands(names, hooked_src: Path | None) -> dict[str, str]:
+def commands(names) -> dict[str, str]:
     """Measurement name -> Python code run in a fresh interpreter."""
     preamble = PREAMBLE.format(payload=payload())
     code = {"interpreter": "pass", "preamble": preamble}
-    inputs = sorted(str(p) for p in (ROOT / "src" / "chain").rglob("*.py"))[:30]
     for name in names:
         code[f"{name}: preamble + imports"] = preamble + script_imports(SCRIPTS / f"{name}.py")
-    if hooked_src is not None:
-        code[f"{HOOKED}'s lookup"] = HOOK.format(src=str(hooked_src), inputs=inputs)
     return code
 
 
@@ -93,28 +76,17 @@ def best_times(code: dict[str, str], rounds: int) -> dict[str, float]:
     return best
 
 
-def hooked_tree(folder: Path) -> Path | None:
-    """The hooked commit's ``src``, from git (None where the checkout lacks it)."""
-    archive = subprocess.run(["git", "archive", "--format=tar", HOOKED, "src"], cwd=ROOT,
-                             capture_output=True)  # fmt: skip
-    if archive.returncode != 0:
-        return None
-    subprocess.run(["tar", "-x", "-C", str(folder)], input=archive.stdout, check=True)
-    return folder / "src"
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--scripts", nargs="+", default=list(DEFAULT_SCRIPTS))
     args = parser.parse_args(argv)
     conditions = Conditions()
-    with tempfile.TemporaryDirectory() as folder:
-        code = commands(args.scripts, hooked_tree(Path(folder)))
-        conditions.sample("before")
-        with OtherProcesses() as others:
-            best = best_times(code, args.rounds)
-        conditions.sample("after")
+    code = commands(args.scripts)
+    conditions.sample("before")
+    with OtherProcesses() as others:
+        best = best_times(code, args.rounds)
+    conditions.sample("after")
     base = best["interpreter"]
     figures = [Figure("interpreter (python -c pass)", base, "s", "Python's start-up")]
     preamble = best["preamble"] - base
@@ -125,11 +97,6 @@ def main(argv=None) -> int:
         own = best[f"{name}: preamble + imports"] - best["preamble"]
         print(f"  {name:24s} imports +{own:.3f} s")
         figures.append(Figure(f"{name}: its imports", own, "s", "the packages it uses"))
-    if f"{HOOKED}'s lookup" in best:
-        hook = best[f"{HOOKED}'s lookup"] - base
-        print(f"  {HOOKED}'s store lookup in each job +{hook:.3f} s (gone: decided before jobs)")
-        figures.append(Figure(f"{HOOKED}'s lookup in each job", hook, "s",
-                              "imports, package versions, input hashes; now 0"))  # fmt: skip
     write_result("bench_job_startup", figures, conditions, others.share)
     return 0
 
