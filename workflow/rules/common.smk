@@ -84,9 +84,8 @@ def key_of(rule, wildcards):
     params = {name: values.evaluate(item) for name, item in proxy.params.items()}
     outputs = [Path(str(path)).name for path in proxy.output]
     script = CHECKOUT / "workflow" / "rules" / proxy.rule.script
-    return RECIPES.key(
-        rule, dict(wildcards), script, params, values.filled(inputs), outputs
-    )
+    inputs = values.filled(inputs)
+    return RECIPES.key(rule, dict(wildcards), script, params, inputs, outputs)
 
 
 #: The run folder (results/<run_name>): path in it -> (rule, output, wildcards) of the
