@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from chain.atomic import write_csv_atomic
+from chain.atomic import atomic_output, write_csv_atomic
 from chain.errors import bead_number_problem
 from chain.sampling import TIME_STEP_TOLERANCE
 
@@ -179,6 +180,51 @@ def _format_dtypes(path: Path) -> dict[str, type]:
         elif name in ("v0_left_m_s", "v0_right_m_s", "t_s") or _SENSOR_COLUMN.match(name):
             dtypes[name] = float
     return dtypes
+
+
+def save_trace_sets(sets: Mapping[str, Sequence[pd.DataFrame]], path: str | os.PathLike) -> None:
+    """Sets of trace tables (a set: one table per chain) in one ``.npz`` file, without
+    pickles, atomically: each column an array (text as unicode), read back identical,
+    dtypes and bits, by :func:`load_trace_sets`.
+
+    Parameters
+    ----------
+    sets : mapping
+        Set name -> its trace tables.
+    path : path
+        The ``.npz`` file.
+    """
+    arrays = {"sets": np.array(list(sets), dtype=str)}
+    for i, tables in enumerate(sets.values()):
+        for j, table in enumerate(tables):
+            for column in table.columns:
+                values = table[column].to_numpy()
+                arrays[f"{i}:{j}:{column}"] = (
+                    values.astype(str) if values.dtype == object else values
+                )
+    with atomic_output(path) as temporary, open(temporary, "wb") as stream:
+        np.savez(stream, **arrays)
+
+
+def load_trace_sets(path: str | os.PathLike) -> dict[str, list[pd.DataFrame]]:
+    """The sets of trace tables :func:`save_trace_sets` wrote: set name -> its tables.
+
+    Parameters
+    ----------
+    path : path
+        The ``.npz`` file.
+    """
+    columns: dict[int, dict[int, dict]] = {}
+    with np.load(path, allow_pickle=False) as saved:
+        names = [str(name) for name in saved["sets"]]
+        for key in saved.files[1:]:
+            i, j, column = key.split(":", 2)
+            values = saved[key]
+            if values.dtype.kind == "U":  # text as the table held it: Python str objects
+                values = np.array(values.tolist(), dtype=object)
+            columns.setdefault(int(i), {}).setdefault(int(j), {})[column] = values
+    return {name: [pd.DataFrame(columns[i][j]) for j in sorted(columns.get(i, {}))]
+            for i, name in enumerate(names)}  # fmt: skip
 
 
 def iter_shots(table: pd.DataFrame):

@@ -1,19 +1,43 @@
-# The ablation study (the virtual experiment, a MODEL, not data): one job (a few seconds
-# of work behind a second of start-up) reruns, in memory, the virtual experiment of every
-# chain with each variant's ingredient changed (ablation.variants: the default run's and
-# the mechanism study's candidates; with studies.ablation: full, all), each distinct
-# launch integrated once and the shots that are the run's read from its datasets;
-# analyses them with the main estimator, fits C and a free exponent, and tabulates
-# tables/ablation_exponent.csv (and, full, tables/ablation_exponent_all.csv).
+# The ablation study (the virtual experiment, a MODEL, not data): ablation_shots reruns,
+# in memory, the virtual experiment of every chain with each variant's ingredient
+# changed (ablation.variants: the default run's and the mechanism study's candidates;
+# with studies.ablation: full, all), each distinct launch integrated once and the shots
+# that are the run's read from its datasets; ablation_variants analyses them with the
+# main estimator (an analysis what-if integrates nothing), fits C and a free exponent,
+# and tabulates tables/ablation_exponent.csv (and, full, ablation_exponent_all.csv).
 
 from chain.pipeline.plan.ablation import AblationPlan
 
 ABLATION = AblationPlan(PLAN)
 
 
-rule ablation_variants:
+rule ablation_shots:
     input:
         datasets=virtual_datasets,
+    output:
+        shots=stored("ablation_shots", "ablation/shots.npz"),
+        sums=stored("ablation_shots", "SHA256SUMS"),
+    log:
+        stored("ablation_shots", "log"),
+    benchmark:
+        stored("ablation_shots", "benchmark.tsv")
+    priority: 1
+    conda:
+        ENV
+    resources:
+        mem_mb=1000,  # MB
+        runtime=30,  # minutes
+    params:
+        variants=lambda w: ABLATION.shots(),
+        run=lambda w: [PLAN.experiment.settings(n) for n in PLAN.chains],
+        series=PLAN.experiment.series,
+    script:
+        "../scripts/ablation_shots.py"
+
+
+rule ablation_variants:
+    input:
+        shots=made("ablation_shots", "shots"),
     output:
         fits=stored("ablation_variants", "ablation/fits.csv"),
         ssw_fits=stored("ablation_variants", "ablation/ssw_fits.csv"),
@@ -32,9 +56,7 @@ rule ablation_variants:
         runtime=30,  # minutes
     params:
         variants=lambda w: ABLATION.job(),
-        run=lambda w: [PLAN.experiment.settings(n) for n in PLAN.chains],
         estimator=config["analysis"]["main_estimator"],
-        series=PLAN.experiment.series,
         table=lambda w: ABLATION.names(full=False),
         table_all=lambda w: ABLATION.names(full=ABLATION.full),
         overrides=ABLATION.overrides,

@@ -1,6 +1,6 @@
-"""Every ablation variant the run makes, in memory: delay fits and SSW fits with the
-main estimator (chain.studies.ablation), the shots that are the run's virtual
-experiment's read from its datasets; the tables from the fits as written."""
+"""Every ablation variant the run makes, analysed: delay fits and SSW fits with the main
+estimator (chain.studies.ablation) of the shots ablation_shots made; the tables from
+the fits as written."""
 
 import pandas as pd
 from _logging import done, start
@@ -8,12 +8,11 @@ from _logging import done, start
 from chain.atomic import write_csv_atomic
 from chain.studies.ablation import run_variants
 from chain.studies.ablation_table import ablation_table
+from chain.traces import load_trace_sets
 
 log = start(snakemake)
 p, out = snakemake.params, snakemake.output
-fits, ssw_fits = run_variants(
-    p.variants, p.run, list(snakemake.input.datasets), p.estimator, p.series
-)
+fits, ssw_fits = run_variants(p.variants, load_trace_sets(snakemake.input.shots), p.estimator)
 write_csv_atomic(fits, out.fits)
 write_csv_atomic(ssw_fits, out.ssw_fits)
 written = pd.read_csv(out.fits)

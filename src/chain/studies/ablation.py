@@ -63,44 +63,73 @@ def variant_fits(
     return fit_pulses(pulses, selection), ssw_fit_table(rows[rows["sensor"] == "S2"])
 
 
-def run_variants(
-    variants: Mapping[str, Mapping],
+def variant_shots(
+    variants: Mapping[str, Sequence],
     run: Sequence[Mapping],
     datasets: Sequence[str | os.PathLike],
-    estimator: str = "fit_full",
     series: str = VIRTUAL_SERIES,
-) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Every variant, replicate after replicate: its shots made in memory
-    (:func:`chain.apparatus.virtual_dataset.virtual_traces`; each distinct launch
+) -> dict[str, list[pd.DataFrame]]:
+    """The shots of every replicate of every variant, made in memory
+    (:func:`chain.apparatus.virtual_dataset.virtual_traces`): each distinct launch
     integrated once for all of them, the shots that are the run's read from its
-    datasets) and fitted (:func:`variant_fits`); a replicate whose settings an earlier
-    one had is not analysed again. Returns (delay fits, SSW fits of the variants with
-    ``ssw``), each row with ``variant``, ``estimator`` and ``replicate`` (0 is the run's
-    seed), the delay fits with the ``seeds`` of the chains.
+    datasets. Returns shot set -> the trace table of each chain, a shot set named by
+    its chains' settings (:func:`shot_set`); replicates with equal settings share one.
+
+    Parameters
+    ----------
+    variants : mapping
+        Variant name -> per replicate, the VirtualExperiment fields of every chain
+        (:func:`chain.pipeline.config.ablation.variant_settings`).
+    run, datasets : sequence
+        The run's virtual experiment of each chain (its fields) and its dataset folder.
+    series : str
+        Series name (the ``model`` column).
+    """
+    runs = [(VirtualExperiment.from_dict(r), d) for r, d in zip(run, datasets, strict=True)]
+    known, shots = {}, {}
+    for replicates in variants.values():
+        for chains in replicates:
+            if shot_set(chains) not in shots:
+                settings = [VirtualExperiment.from_dict(c) for c in chains]
+                shots[shot_set(chains)] = [virtual_traces(s, series, known, r)
+                                           for s, r in zip(settings, runs)]  # fmt: skip
+    return shots
+
+
+def shot_set(chains: Sequence[Mapping]) -> str:
+    """The name of the shots of one replicate: its chains' settings, as JSON."""
+    return json.dumps(chains, sort_keys=True)
+
+
+def run_variants(
+    variants: Mapping[str, Mapping],
+    shots: Mapping[str, Sequence[pd.DataFrame]],
+    estimator: str = "fit_full",
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Every variant's fits, replicate after replicate (:func:`variant_fits`, with one
+    estimator); a replicate whose settings an earlier one had is not analysed again.
+    Returns (delay fits, SSW fits of the variants with ``ssw``), each row with
+    ``variant``, ``estimator`` and ``replicate`` (0 is the run's seed), the delay fits
+    with the ``seeds`` of the chains.
 
     Parameters
     ----------
     variants : mapping
         Variant name -> {"settings": per replicate, the VirtualExperiment fields of every
-        chain (:func:`chain.pipeline.config.ablation.variant_settings`); "tolerance":
-        relative, or None to keep every collision shot; "ssw": fit the SSW too}.
-    run, datasets : sequence
-        The run's virtual experiment of each chain (its fields) and its dataset folder.
+        chain; "tolerance": relative, or None to keep every collision shot; "ssw": fit
+        the SSW too}.
+    shots : mapping
+        :func:`variant_shots` of those settings.
     estimator : str
         Pulse estimator (:data:`chain.analysis.pulses.ESTIMATORS`).
-    series : str
-        Series name (the ``model`` column).
     """
-    runs = [(VirtualExperiment.from_dict(r), d) for r, d in zip(run, datasets, strict=True)]
-    known, analysed, fits, ssw_fits = {}, {}, [], []
+    analysed, fits, ssw_fits = {}, [], []
     for name, variant in variants.items():
         tolerance, fit_ssw = variant["tolerance"], variant["ssw"]
         for replicate, chains in enumerate(variant["settings"]):
-            key = json.dumps([chains, tolerance, fit_ssw])
+            key = json.dumps([shot_set(chains), tolerance, fit_ssw])
             if key not in analysed:
-                shots = [VirtualExperiment.from_dict(c) for c in chains]
-                traces = [virtual_traces(s, series, known, r) for s, r in zip(shots, runs)]
-                analysed[key] = variant_fits(traces, tolerance, estimator, fit_ssw)
+                analysed[key] = variant_fits(shots[shot_set(chains)], tolerance, estimator, fit_ssw)
             delays, ssw = analysed[key]
             seeds = " ".join(str(c["seed"]) for c in chains)
             rows = delays[["N", "C_us_N16", "C_stderr_us_N16", "exponent", "exponent_stderr"]]

@@ -77,6 +77,10 @@ class AblationPlan:
         """Acceptance tolerance of a variant; None keeps every collision shot."""
         return variant_tolerance(self.plan.config, self.variants[name])
 
+    def shots(self) -> dict[str, list[list[dict]]]:
+        """Variant -> :meth:`settings` of :attr:`made`: what the shots depend on."""
+        return {name: self.settings(name) for name in self.made}
+
     def job(self) -> dict[str, dict]:
         """Variant -> {settings: :meth:`settings`; tolerance: :meth:`tolerance`; ssw:
         whether its SSW is fitted (a candidate's)} of :attr:`made`."""
