@@ -3,9 +3,7 @@ batch by batch, read at the sensors (a MODEL; see :mod:`chain.apparatus.virtual`
 
 from __future__ import annotations
 
-import hashlib
 import itertools
-import logging
 import math
 from dataclasses import asdict
 
@@ -37,8 +35,6 @@ _NOT_INTEGRATED = set(
     "reference_speed_mismatch timing_jitter_s right_speed_offset right_delay_s noise_N adc_bits "
     "adc_range_V sensitivity_mV_per_N time_step_s radius_dispersion gap_mean_m gap_spread_m".split()
 )
-
-log = logging.getLogger(__name__)
 
 
 def _launcher(model, side: int) -> slice:
@@ -168,7 +164,7 @@ def simulate_virtual_shots(
     (chain, time step, kind, speeds, delay) is integrated once: a repeat, in ``plan`` or
     in ``known`` (launch -> (time, readings), filled here; one dict for calls that may
     share launches), takes its readings, the same to the bit (each launch is integrated
-    on its own). The log names each launch integrated by a digest of its readings.
+    on its own; the integrator's log names each launch it integrates).
     """
     check_switches(settings)
     radii, gaps = chain_draws(settings)
@@ -198,6 +194,4 @@ def simulate_virtual_shots(
             rest_displacement(model, gaps),
         )  # fmt: skip
         known.update((k, (time, r)) for k, r in zip(new, readings))
-        digests = [hashlib.blake2b(r.tobytes(), digest_size=8).hexdigest() for r in readings]
-        log.info("integrated %d %s launches: %s", len(new), kind, " ".join(digests))
     return known[launches[0]][0], np.stack([known[k][1] for k in launches])

@@ -10,6 +10,8 @@ dissipation, which makes the energy drift a check on the step in every run.
 
 from __future__ import annotations
 
+import hashlib
+import logging
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -21,6 +23,10 @@ from chain.errors import ParameterError, require_int, require_positive
 from chain.physics.kernels import _OK
 from chain.physics.launches import _lean_launches, _reference_launches, _run_launches
 from chain.physics.model import ChainModel
+
+#: Names each launch it integrates (:func:`launch_digests`), so that a run's logs show
+#: whether any launch was integrated twice.
+log = logging.getLogger(__name__)
 
 #: Default bound on the relative energy drift before a run is declared broken.
 DEFAULT_MAX_ENERGY_DRIFT = 1e-6
@@ -199,6 +205,8 @@ def _prepare(
     n_steps = math.ceil(duration / dt - 1e-9)
     n_samples = n_steps // record_every + 1
     run = (displacement, velocity, dt, n_steps, record_every)
+    digests = launch_digests(model, displacement, velocity, dt, n_steps)
+    log.info("integrating %d launches: %s", len(digests), " ".join(digests))
     if kernel == "lean":
         outputs, report, launches = _lean_launches(model, run, n_samples, links, particles)
     else:
@@ -206,6 +214,34 @@ def _prepare(
     return _Batch(
         model, run, n_samples, links, particles, max_energy_drift, outputs, report, launches
     )
+
+
+def launch_digests(model: ChainModel, displacement, velocity, dt: float, n_steps: int):
+    """A digest of each launch of a batch: of what its trajectory depends on (the chain's
+    masses, links and walls, its initial state, the step and the number of steps);
+    two launches with one digest are the same integration.
+
+    Parameters
+    ----------
+    model : ChainModel
+        The chain.
+    displacement, velocity : (B, P) arrays
+        Initial displacements (m) and velocities (m/s) of each launch.
+    dt : float
+        Time step, s.
+    n_steps : int
+        Steps integrated.
+    """
+    chain = hashlib.blake2b(f"{dt!r} {n_steps}".encode(), digest_size=8)
+    for name in ("masses", "link_kind", "link_stiffness", "link_eta", "wall_stiffness",
+                 "wall_eta", "drag_rate"):  # fmt: skip
+        chain.update(np.ascontiguousarray(getattr(model, name)).tobytes())
+    digests = []
+    for x, v in zip(displacement, velocity, strict=True):
+        launch = chain.copy()
+        launch.update(np.ascontiguousarray(x).tobytes() + np.ascontiguousarray(v).tobytes())
+        digests.append(launch.hexdigest())
+    return digests
 
 
 def _finish(batch: _Batch) -> RawTrajectory:
