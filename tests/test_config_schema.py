@@ -388,7 +388,7 @@ BAD_CONFIGS = {
     "long chain long enough": (
         setter("long_chains", "N", value=[2]),
         on("long_chains", "N", 0),
-        "less than the minimum of 3",
+        "less than the minimum of 26",
     ),
     "unique model names": (
         setter("models", 1, "name", value="elastic"),

