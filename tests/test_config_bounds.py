@@ -201,7 +201,7 @@ def test_value_outside_is_stopped_naming_the_key(plain, path, outside, inside):
 
 
 def test_every_variant_is_checked_with_its_settings(tiny):
-    """`snakemake ablation` runs every variant, not only those of the default run."""
+    """`studies.ablation: full` runs every variant, not only those of the default run."""
     variants = [{"name": "slow", "set": {"duration_s": 2e-4}}]
     message = outcome(tiny, {"ablation": {"variants": variants}})
     assert "config key 'ablation.variants[0].set' (variant 'slow')" in message
@@ -246,7 +246,7 @@ def test_table_is_generated_from_schema_and_rules():
     schema = yaml.safe_load(SCHEMA.read_text())
     table = bounds_table(schema)
     assert (ROOT / "docs" / "config_bounds.md").read_text() == table, (
-        "regenerate: python -m chain.pipeline.config.bounds "
+        "regenerate: python -m chain.pipeline.config.bounds_table "
         "workflow/schemas/config.schema.yaml > docs/config_bounds.md"
     )
     keys = {line.split("`")[1] for line in table.splitlines() if line.startswith("| `")}

@@ -159,8 +159,8 @@ RULES = {
     "ablation.variants[].mechanism": "free text (tables/ssw_mechanisms.csv)",
     "ablation.variants[].set": (
         "every bound of experiment.virtual, setup.striker_radius_m and "
-        "experiment.tolerance, on the variant's own settings (every variant: `snakemake "
-        "ablation` runs them all)"
+        "experiment.tolerance, on the variant's own settings (every variant: "
+        "`studies.ablation: full` runs them all)"
     ),
 }
 
