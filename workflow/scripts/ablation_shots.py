@@ -4,7 +4,7 @@ kept as trace tables for the analysis (chain.traces.save_trace_sets)."""
 
 from _logging import done, start
 
-from chain.studies.ablation import variant_shots
+from chain.studies.ablation_shots import variant_shots
 from chain.traces import save_trace_sets
 
 log = start(snakemake)

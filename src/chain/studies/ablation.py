@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 from collections.abc import Mapping, Sequence
 
 import pandas as pd
@@ -19,9 +18,6 @@ from chain.analysis.pulse_rows import pulse_table
 from chain.analysis.recipe import fit_pulses
 from chain.analysis.selection import select_shots
 from chain.analysis.ssw import ssw_fit_table, ssw_table
-from chain.apparatus.virtual import VirtualExperiment
-from chain.apparatus.virtual_dataset import virtual_traces
-from chain.labels import VIRTUAL_SERIES
 
 log = logging.getLogger(__name__)
 
@@ -63,39 +59,6 @@ def variant_fits(
     return fit_pulses(pulses, selection), ssw_fit_table(rows[rows["sensor"] == "S2"])
 
 
-def variant_shots(
-    variants: Mapping[str, Sequence],
-    run: Sequence[Mapping],
-    datasets: Sequence[str | os.PathLike],
-    series: str = VIRTUAL_SERIES,
-) -> dict[str, list[pd.DataFrame]]:
-    """The shots of every replicate of every variant, made in memory
-    (:func:`chain.apparatus.virtual_dataset.virtual_traces`): each distinct launch
-    integrated once for all of them, the shots that are the run's read from its
-    datasets. Returns shot set -> the trace table of each chain, a shot set named by
-    its chains' settings (:func:`shot_set`); replicates with equal settings share one.
-
-    Parameters
-    ----------
-    variants : mapping
-        Variant name -> per replicate, the VirtualExperiment fields of every chain
-        (:func:`chain.pipeline.config.ablation.variant_settings`).
-    run, datasets : sequence
-        The run's virtual experiment of each chain (its fields) and its dataset folder.
-    series : str
-        Series name (the ``model`` column).
-    """
-    runs = [(VirtualExperiment.from_dict(r), d) for r, d in zip(run, datasets, strict=True)]
-    known, shots = {}, {}
-    for replicates in variants.values():
-        for chains in replicates:
-            if shot_set(chains) not in shots:
-                settings = [VirtualExperiment.from_dict(c) for c in chains]
-                shots[shot_set(chains)] = [virtual_traces(s, series, known, r)
-                                           for s, r in zip(settings, runs)]  # fmt: skip
-    return shots
-
-
 def shot_set(chains: Sequence[Mapping]) -> str:
     """The name of the shots of one replicate: its chains' settings, as JSON."""
     return json.dumps(chains, sort_keys=True)
@@ -119,7 +82,7 @@ def run_variants(
         chain; "tolerance": relative, or None to keep every collision shot; "ssw": fit
         the SSW too}.
     shots : mapping
-        :func:`variant_shots` of those settings.
+        :func:`chain.studies.ablation_shots.variant_shots` of those settings.
     estimator : str
         Pulse estimator (:data:`chain.analysis.pulses.ESTIMATORS`).
     """
