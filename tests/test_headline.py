@@ -10,7 +10,7 @@ import pytest
 
 from chain.cli import main
 from chain.pipeline.provenance import headline
-from chain.pipeline.run.checksums import write_checksums
+from chain.pipeline.provenance.checksums import write_checksums
 
 
 def _summary() -> dict:

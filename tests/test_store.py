@@ -24,11 +24,11 @@ from pathlib import Path
 import pytest
 
 import chain
-from chain import atomic
+from chain import atomic, trust
 from chain.cli import main
+from chain.pipeline.provenance.checksums import CHECKSUMS, checksum_problems
 from chain.pipeline.provenance.record import package_versions
-from chain.pipeline.run import recipe, store_path
-from chain.pipeline.run.checksums import CHECKSUMS, checksum_problems
+from chain.pipeline.run import recipe
 from chain.pipeline.run.entries import (
     GROUP_VARIABLE,
     SUMS,
@@ -735,11 +735,11 @@ def test_a_refusal_names_a_file_system_whose_owners_cannot_be_trusted(tmp_path, 
         f"40 22 0:50 / {tmp_path} rw,relatime shared:1 - nfs4 server:/home rw\n"
         f"41 40 0:51 / {tmp_path}/local\\040disk rw - ext4 /dev/sdb1 rw\n"
     )
-    assert store_path.file_system(tmp_path / "a", table) == ("nfs4", str(tmp_path))
-    assert store_path.file_system(tmp_path / "local disk" / "a", table)[0] == "ext4"
-    assert store_path.file_system("/etc", table) == ("ext4", "/")
-    real = store_path.file_system
-    monkeypatch.setattr(store_path, "file_system", lambda path: real(path, table))
+    assert trust.file_system(tmp_path / "a", table) == ("nfs4", str(tmp_path))
+    assert trust.file_system(tmp_path / "local disk" / "a", table)[0] == "ext4"
+    assert trust.file_system("/etc", table) == ("ext4", "/")
+    real = trust.file_system
+    monkeypatch.setattr(trust, "file_system", lambda path: real(path, table))
     os.chmod(tmp_path, 0o777)
     with pytest.raises(StoreError, match=r"is on a nfs4 file system .* cannot be made there"):
         open_store({STORE_VARIABLE: str(tmp_path / "store")})

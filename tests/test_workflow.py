@@ -576,7 +576,7 @@ def test_the_html_report_shows_every_figure_and_the_scripts_code(tiny_checkout, 
 def test_a_run_folder_is_plain_files_with_their_checksums(tiny_checkout, tmp_path):
     """The run folder holds files, no links, and SHA256SUMS lists every one of them as
     ``sha256sum -c`` checks it; a copy without the store beside it stays whole."""
-    from chain.pipeline.run.checksums import checksum_problems
+    from chain.pipeline.provenance.checksums import checksum_problems
 
     _, out, _, _ = tiny_checkout
     assert not [p for p in out.rglob("*") if p.is_symlink()]

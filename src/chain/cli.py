@@ -317,8 +317,8 @@ def _check(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from chain.pipeline.provenance import headline
+    from chain.pipeline.provenance.checksums import checksum_problems
     from chain.pipeline.provenance.record import lock_warnings
-    from chain.pipeline.run.checksums import checksum_problems
 
     folder = Path(args.run_folder)
     summary_path = folder / "summary.json"

@@ -12,6 +12,7 @@ from __future__ import annotations
 import grp
 import os
 import pwd
+import re
 import stat
 from pathlib import Path
 
@@ -134,3 +135,56 @@ def _member(uid: int, gid: int) -> bool:
         return user.pw_gid == gid or user.pw_name in grp.getgrgid(gid).gr_mem
     except KeyError:
         return False
+
+
+#: File systems whose owners and modes need not be the accounts' own (and ``fuse.*``).
+FOREIGN_OWNERS = frozenset(
+    {"nfs", "nfs4", "cifs", "smb3", "smbfs", "9p", "vfat", "exfat", "msdos", "ntfs", "ntfs3"}
+)
+
+
+def file_system(path: str | os.PathLike, mountinfo: str = "/proc/self/mountinfo"):
+    """The type and mount point of the file system holding ``path`` (a resolved
+    path), as Linux lists them; None where it does not.
+
+    Parameters
+    ----------
+    path : path
+        An absolute path without links.
+    mountinfo : str
+        The mount table (``/proc/self/mountinfo``'s format).
+    """
+    try:
+        lines = Path(mountinfo).read_text().splitlines()
+    except OSError:
+        return None
+    path, found = str(path), None
+    for fields in (line.split() for line in lines):
+        if "-" not in fields:
+            continue
+        point = re.sub(r"\\([0-7]{3})", lambda m: chr(int(m.group(1), 8)), fields[4])
+        inside = path == point or path.startswith(point.rstrip("/") + "/")
+        if inside and (found is None or len(point) >= len(found[1])):  # later mounts hide
+            found = (fields[fields.index("-") + 1], point)
+    return found
+
+
+def foreign_owners(here: Path) -> str:
+    """A word on the file system of ``here`` when its owners and modes need not be the
+    accounts' own (NFS with root squash maps root to ``nobody``; SMB shares and FAT
+    disks give every file one owner and mode), so that no check of who may write can
+    be made there; "" elsewhere.
+
+    Parameters
+    ----------
+    here : Path
+        An absolute path.
+    """
+    found = file_system(here)
+    if found is None or not (found[0] in FOREIGN_OWNERS or found[0].startswith("fuse")):
+        return ""
+    return (
+        f"{here} is on a {found[0]} file system ({found[1]}), whose owners and modes need "
+        "not be the accounts' own (root squash, one owner for a whole share): this check "
+        "cannot be made there"
+    )

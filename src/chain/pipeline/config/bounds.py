@@ -36,7 +36,8 @@ def check_bounds(config: Mapping, check: Callable[[Mapping], None] | None = None
     """Check the bounds that depend on other keys of ``config`` (schema-valid, checked up
     to the ablation), then run ``check`` (the whole config check; None: not) on each
     ablation variant's config (:func:`variant_config`), whatever the source
-    (``studies.ablation: full`` runs them all). :class:`ConfigError` naming the first offending key."""
+    (``studies.ablation: full`` runs them all). :class:`ConfigError` naming the first
+    offending key."""
     check_run_bounds(config)
     if config["experiment"]["source"] == "virtual":
         check_experiment_bounds(config)

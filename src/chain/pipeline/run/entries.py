@@ -16,7 +16,6 @@ Snakemake computes it again.
 
 from __future__ import annotations
 
-import hashlib
 import os
 import re
 import shutil
@@ -25,13 +24,12 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from chain.atomic import write_text_atomic
+from chain.pipeline.provenance.checksums import file_digest, files_under
 
 #: An entry's list of digests (the format of ``sha256sum``).
 SUMS = "SHA256SUMS"
 #: An entry's folder name: rule, wildcards' label, 32 hex digits of its recipe's key.
 ENTRY = re.compile(r"^(?P<rule>[A-Za-z_]\w*)(?:-(?P<label>.+))?-(?P<key>[0-9a-f]{32})$")
-#: Bytes read at a time.
-CHUNK = 1 << 20
 #: The group a store is shared with (chain.pipeline.run.store_path): its entries
 #: are the group's to read.
 GROUP_VARIABLE = "HERTZCHAIN_STORE_GROUP"
@@ -39,30 +37,6 @@ GROUP_VARIABLE = "HERTZCHAIN_STORE_GROUP"
 
 class DamagedEntry(RuntimeError):
     """A stored file does not match its entry's digest; the message names it."""
-
-
-def file_digest(path: str | os.PathLike) -> str:
-    """SHA-256 (hex) of a file's bytes, or of a folder's files (names and digests)."""
-    path = Path(path)
-    if path.is_dir():
-        listing = [f"{name}\0{file_digest(path / name)}" for name in files_under(path)]
-        return hashlib.sha256("\n".join(listing).encode()).hexdigest()
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        while chunk := stream.read(CHUNK):
-            digest.update(chunk)
-    return digest.hexdigest()
-
-
-def files_under(folder: str | os.PathLike) -> list[str]:
-    """Every file below ``folder``, as sorted relative POSIX paths; hidden files left
-    out (Snakemake's ``.snakemake_timestamp``, an interrupted writer's temporary)."""
-    root = Path(folder)
-    return sorted(
-        p.relative_to(root).as_posix()
-        for p in root.rglob("*")
-        if not p.is_dir() and not any(part.startswith(".") for part in p.relative_to(root).parts)
-    )
 
 
 def entry_of(path: str | os.PathLike) -> Path | None:

@@ -17,16 +17,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from chain.atomic import atomic_output
-from chain.pipeline.run.checksums import write_checksums
-from chain.pipeline.run.entries import (
-    CHUNK,
-    ENTRY,
-    SUMS,
-    DamagedEntry,
-    discard,
-    entry_of,
-    read_sums,
-)
+from chain.pipeline.provenance.checksums import CHUNK, write_checksums
+from chain.pipeline.run.entries import ENTRY, SUMS, DamagedEntry, discard, entry_of, read_sums
 
 #: The run folder's own records, rewritten whole by every copy.
 RECORDS = ("logs", "benchmarks")

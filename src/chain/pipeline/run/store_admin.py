@@ -14,7 +14,7 @@ import datetime
 import os
 from pathlib import Path
 
-from chain.pipeline.run.checksums import CHECKSUMS
+from chain.pipeline.provenance.checksums import CHECKSUMS
 from chain.pipeline.run.entries import ENTRY, SUMS, discard, read_sums
 from chain.pipeline.run.publish import upstream
 

@@ -7,17 +7,14 @@ each owned by the user or root and writable by no one else (a group's store: by 
 members and that group, never by everyone). A missing store is made the user's (0700)
 or its group's (2770), and the folders above it writable by the user alone.
 
-Owners and modes are what the file system reports. Some report others than the
-accounts' own (NFS with root squash maps root to ``nobody``; SMB shares and FAT disks
-give every file one owner and mode): a refusal there names the file system
-(:data:`FOREIGN_OWNERS`).
+Owners and modes are what the file system reports: a refusal on one whose owners are
+not the accounts' own names it (:func:`chain.trust.foreign_owners`).
 """
 
 from __future__ import annotations
 
 import grp
 import os
-import re
 from pathlib import Path
 
 from chain import trust
@@ -28,10 +25,6 @@ from chain.pipeline.run.entries import GROUP_VARIABLE
 STORE_VARIABLE = "HERTZCHAIN_STORE"
 #: The store's folder relative to the working directory: ``rm -r results`` empties it.
 DEFAULT_FOLDER = "results/.store"
-#: File systems whose owners and modes need not be the accounts' own (and ``fuse.*``).
-FOREIGN_OWNERS = frozenset(
-    {"nfs", "nfs4", "cifs", "smb3", "smbfs", "9p", "vfat", "exfat", "msdos", "ntfs", "ntfs3"}
-)
 
 
 class StoreError(RuntimeError):
@@ -72,7 +65,9 @@ def open_store(environ, trusted=(), create: bool = True) -> str:
             )
             if found.startswith(f"{path} "):  # the store itself
                 fix += f"; {GROUP_VARIABLE} shares a store with one group on purpose"
-            raise StoreError(f"result store {root}: {found}, {fix}{_foreign_owners(path)}")
+            note = trust.foreign_owners(path)
+            note = f" ({note}; set {STORE_VARIABLE} to a folder on a local disk)" if note else ""
+            raise StoreError(f"result store {root}: {found}, {fix}{note}")
     if create and not path.is_dir():
         try:
             _make(path, group)
@@ -111,42 +106,3 @@ def group_id(name: str | None) -> int | None:
     if os.getuid() != 0 and gid != os.getegid() and gid not in os.getgroups():
         raise StoreError(f"{GROUP_VARIABLE}={name}: you are not a member of group {name}")
     return gid
-
-
-def file_system(path: str | os.PathLike, mountinfo: str = "/proc/self/mountinfo"):
-    """The type and mount point of the file system holding ``path`` (a resolved
-    path), as Linux lists them; None where it does not.
-
-    Parameters
-    ----------
-    path : path
-        An absolute path without links.
-    mountinfo : str
-        The mount table (``/proc/self/mountinfo``'s format).
-    """
-    try:
-        lines = Path(mountinfo).read_text().splitlines()
-    except OSError:
-        return None
-    path, found = str(path), None
-    for fields in (line.split() for line in lines):
-        if "-" not in fields:
-            continue
-        point = re.sub(r"\\([0-7]{3})", lambda m: chr(int(m.group(1), 8)), fields[4])
-        inside = path == point or path.startswith(point.rstrip("/") + "/")
-        if inside and (found is None or len(point) >= len(found[1])):  # later mounts hide
-            found = (fields[fields.index("-") + 1], point)
-    return found
-
-
-def _foreign_owners(here: Path) -> str:
-    """A word on the file system of ``here`` when its owners and modes may not be the
-    accounts' own: the check cannot be trusted there."""
-    found = file_system(here)
-    if found is None or not (found[0] in FOREIGN_OWNERS or found[0].startswith("fuse")):
-        return ""
-    return (
-        f" ({here} is on a {found[0]} file system ({found[1]}), whose owners and modes "
-        "need not be the accounts' own (root squash, one owner for a whole share): "
-        f"this check cannot be made there; set {STORE_VARIABLE} to a folder on a local disk)"
-    )

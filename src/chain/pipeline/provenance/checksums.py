@@ -7,15 +7,41 @@ folders (an interrupted copy's temporary file) are never listed.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Mapping
 from pathlib import Path
 
 from chain.atomic import write_text_atomic
-from chain.pipeline.run.entries import file_digest
 
+#: Bytes read at a time.
+CHUNK = 1 << 20
 #: The checksum file of a run folder.
 CHECKSUMS = "SHA256SUMS"
+
+
+def file_digest(path: str | os.PathLike) -> str:
+    """SHA-256 (hex) of a file's bytes, or of a folder's files (names and digests)."""
+    path = Path(path)
+    if path.is_dir():
+        listing = [f"{name}\0{file_digest(path / name)}" for name in files_under(path)]
+        return hashlib.sha256("\n".join(listing).encode()).hexdigest()
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        while chunk := stream.read(CHUNK):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def files_under(folder: str | os.PathLike) -> list[str]:
+    """Every file below ``folder``, as sorted relative POSIX paths; hidden files left
+    out (Snakemake's ``.snakemake_timestamp``, an interrupted writer's temporary)."""
+    root = Path(folder)
+    return sorted(
+        p.relative_to(root).as_posix()
+        for p in root.rglob("*")
+        if not p.is_dir() and not any(part.startswith(".") for part in p.relative_to(root).parts)
+    )
 
 
 def run_files(folder: str | os.PathLike) -> list[str]:
