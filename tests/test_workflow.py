@@ -88,7 +88,7 @@ SIMULATION_CODE = ("physics/integrator.py", "physics/lammps_engine.py")
 #: only imports an integrating module (to read what a simulation recorded) is none.
 SIMULATIONS = (
     "simulate", "long_chain", "virtual_experiment", "c_sensitivity_simulate", "lammps_check",
-    "lammps_setting", "ablation_variant", "ablation_variants",
+    "lammps_setting", "ablation_shots",
 )  # fmt: skip
 
 #: The run folder's files that state the run (its name, its config's hash); logs/,
