@@ -152,7 +152,7 @@ class RunPlan:
         }
 
     def chain(self, model: str, n_beads: int) -> ChainModel:
-        """The chain that the simulate (and ssw_track) job of a model and N integrates."""
+        """The chain that the simulate (or long_chain) job of a model and N integrates."""
         return chain_of(self.simulate_job(model, n_beads))
 
     @cached_property

@@ -1,5 +1,5 @@
 """The simulation's facts: the chains of the space-time figure, and what a simulate
-(or ssw_track) job asks a scheduler for."""
+(or long_chain) job asks a scheduler for."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from chain.pipeline.plan.resources import simulation_needs, simulation_threads
 
 
 class SimulationPlan:
-    """The facts of the simulate, ssw_track and ssw_fields jobs of a run.
+    """The facts of the simulate and long_chain jobs of a run.
 
     Parameters
     ----------
@@ -31,7 +31,7 @@ class SimulationPlan:
         return (self.plan.conservative or (self.plan.config["figures"]["traces_model"],))[0]
 
     def threads(self, wildcards) -> int:
-        """Cores a simulate (or ssw_track) job is worth
+        """Cores a simulate (or long_chain) job is worth
         (:func:`chain.pipeline.plan.resources.simulation_threads`)."""
         job = self._job(wildcards)
         return simulation_threads(
@@ -40,11 +40,11 @@ class SimulationPlan:
         )  # fmt: skip
 
     def mem_mb(self, wildcards, threads) -> int:
-        """Memory a simulate (or ssw_track) job asks a scheduler for, MB."""
+        """Memory a simulate (or long_chain) job asks a scheduler for, MB."""
         return self._needs(wildcards, threads).mem_mb
 
     def runtime(self, wildcards, threads) -> int:
-        """Run time a simulate (or ssw_track) job asks a scheduler for, minutes."""
+        """Run time a simulate (or long_chain) job asks a scheduler for, minutes."""
         return self._needs(wildcards, threads).runtime
 
     def _job(self, wildcards) -> dict:
