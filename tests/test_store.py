@@ -471,6 +471,9 @@ STOPPED = textwrap.dedent("""
     from chain.pipeline.run import publish
     how, sums, *pairs = sys.argv[2:]
     signal.signal(signal.SIGTERM, stop_once)  # as in a job (_logging.start)
+    # Started from a background job, this process may inherit SIGINT ignored: a job
+    # that Snakemake runs in the foreground takes it as Python does by default.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     class Stopping:  # the second copy is stopped as it starts writing
         made = 0
