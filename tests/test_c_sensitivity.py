@@ -73,7 +73,8 @@ def test_recorded_readings_give_the_shots_the_study_would_simulate_bit_for_bit(t
     shifted sensors there instead of integrating the same launches again: the trace
     table is the one simulated for those beads alone, bit for bit (recording every
     contact does not change the integration)."""
-    from chain.apparatus.shots import readings_table, save_readings, simulate_launches
+    from chain.apparatus.readings import readings_table, save_readings
+    from chain.apparatus.shots import simulate_launches
 
     model, speeds, beads = uniform_chain(16, eta=0.58e-6), [0.05, 0.2], [4, 6, 11, 13]
     alone, _ = simulate_shots(model, speeds, beads, model_name="m", duration=1.4e-3)

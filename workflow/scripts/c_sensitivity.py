@@ -4,7 +4,7 @@ the study's simulations recorded (input readings: every bead's force)."""
 
 from _logging import done, start
 
-from chain.apparatus.shots import readings_table
+from chain.apparatus.readings import readings_table
 from chain.atomic import write_csv_atomic
 from chain.studies.c_sensitivity import c_sensitivity_table
 

@@ -1,10 +1,11 @@
 """The simulations of the C-sensitivity study at an eta no configured model has, every
-chain: every bead's felt force (chain.apparatus.shots.save_readings), for its shifted
+chain: every bead's felt force (chain.apparatus.readings.save_readings), for its shifted
 sensors."""
 
 from _logging import done, start
 
-from chain.apparatus.shots import save_readings, simulate_launches
+from chain.apparatus.readings import save_readings
+from chain.apparatus.shots import simulate_launches
 from chain.pipeline.plan.jobs import chain_of, simulation_kwargs
 
 log = start(snakemake)

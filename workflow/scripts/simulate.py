@@ -6,7 +6,8 @@ every bead's felt force (what the C-sensitivity study reads at its shifted senso
 from _logging import done, start
 
 from chain.analysis.ssw_track import pooled_field, ssw_track_table
-from chain.apparatus.shots import save_readings, shot_tables, simulate_launches
+from chain.apparatus.readings import save_readings
+from chain.apparatus.shots import shot_tables, simulate_launches
 from chain.atomic import write_csv_atomic
 from chain.pipeline.plan.jobs import chain_of, simulation_kwargs
 from chain.traces import write_traces

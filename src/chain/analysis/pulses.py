@@ -36,6 +36,7 @@ from chain.analysis.cos6 import (  # noqa: F401 (cos6_model: a public name here 
     Cos6Evaluations,
     cos6_model,
 )
+from chain.analysis.peaks import find_peaks, peak_width
 from chain.analysis.smoothing import savgol_dot_coefficients, smoothed_interior
 from chain.errors import ParameterError
 
@@ -189,7 +190,8 @@ def find_pulses(
     """The main pulses of a signal, in time order, as index ranges (empty when no pulse
     clears the thresholds).
 
-    Peaks are found with :func:`scipy.signal.find_peaks`; a main pulse has a prominence
+    Peaks are found as :func:`scipy.signal.find_peaks` finds them
+    (:func:`chain.analysis.peaks.find_peaks`); a main pulse has a prominence
     of at least ``rel_prominence`` times the largest excursion and a height above
     ``max(min_snr * noise_N, min_height_N)``. The ``max_pulses`` most prominent are
     kept; maxima closer than the full width at half maximum of the largest pulse count
@@ -216,8 +218,6 @@ def find_pulses(
     """
     time, force = _as_signal(time_s, force_N)
     baseline_N, noise_N = _baseline(time, force, baseline_N, noise_N)
-    from scipy.signal import find_peaks, peak_widths  # see chain.analysis.smoothing
-
     signal = force - baseline_N
     largest = float(signal.max())
     threshold = max(min_snr * noise_N, min_height_N)
@@ -226,7 +226,7 @@ def find_pulses(
     # Samples of one top tie when the data are quantised (each then has the full
     # prominence): maxima closer than the width at half maximum of the largest pulse
     # belong to one pulse, and pulses that close could not be told apart anyway.
-    fwhm = _half_width_samples(signal, int(np.argmax(signal)))
+    fwhm = peak_width(signal, int(np.argmax(signal)))
     peaks, properties = find_peaks(
         signal, height=threshold, prominence=rel_prominence * largest, distance=max(1.0, fwhm)
     )
@@ -234,7 +234,7 @@ def find_pulses(
         return []
     strongest = np.argsort(properties["prominences"])[::-1][:max_pulses]
     peaks = np.sort(peaks[strongest])
-    widths = peak_widths(signal, peaks, rel_height=0.5)[0]
+    widths = [peak_width(signal, peak) for peak in peaks]
     segments = []
     for i, peak in enumerate(peaks):
         reach = math.ceil(SEGMENT_HALF_WIDTH_FWHM * float(widths[i]))
@@ -309,7 +309,7 @@ def measure_pulse(
     peak = int(np.argmax(signal))
     if not signal[peak] > 0:
         return failed("no positive pulse")
-    half_width = _half_width_samples(signal, peak)
+    half_width = peak_width(signal, peak)
     if not half_width > 0:
         return failed("pulse width not measurable")
     dt = float(np.median(np.diff(time)))
@@ -342,13 +342,6 @@ def _as_signal(time_s, force_N) -> tuple[np.ndarray, np.ndarray]:
     if time.size == 0:
         raise ParameterError("time_s and force_N are empty")
     return time, force
-
-
-def _half_width_samples(signal: np.ndarray, peak: int) -> float:
-    # Full width at half maximum, in samples, interpolated between samples.
-    from scipy.signal import peak_widths  # imported here: see chain.analysis.smoothing
-
-    return float(peak_widths(signal, [peak], rel_height=0.5)[0][0])
 
 
 def _window(time, arrival, tau, rising_only: bool) -> tuple[int, int]:

@@ -2,8 +2,9 @@
 as every pulse of a sweep sampled alike asks for the same few), the filter on just the
 samples that are read, its gain on white noise, and the tau/2 smoothing of the SSW.
 
-scipy.signal and scipy.ndimage are imported where used: they take most of a second to
-import, and many jobs import the analysis for its names only.
+scipy.ndimage is imported where used, as is scipy.signal, which takes 0.25-0.4 s to
+import: the coefficients are its own formula (:func:`savgol_coeffs`), and only a window
+that reaches a record's ends takes its filter.
 """
 
 from __future__ import annotations
@@ -27,9 +28,7 @@ def savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
     dt : float
         Sampling interval, s.
     """
-    from scipy.signal import savgol_coeffs
-
-    coefficients = tuple(savgol_coeffs(length, 2, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
+    coefficients = tuple(savgol_coeffs(length, deriv=d, delta=dt, use="dot") for d in (0, 1, 2))
     for c in coefficients:
         c.flags.writeable = False
     return coefficients
@@ -39,11 +38,25 @@ def savgol_dot_coefficients(length: int, dt: float) -> tuple[np.ndarray, ...]:
 def smoothing_coefficients(length: int) -> np.ndarray:
     """Coefficients of ``scipy.signal.savgol_filter(x, length, 2)`` (read-only), for an
     odd window ``length`` in samples."""
-    from scipy.signal import savgol_coeffs
-
-    coefficients = savgol_coeffs(length, 2)
+    coefficients = savgol_coeffs(length)
     coefficients.flags.writeable = False
     return coefficients
+
+
+def savgol_coeffs(length: int, deriv: int = 0, delta: float = 1.0, use: str = "conv"):
+    """``scipy.signal.savgol_coeffs(length, 2, deriv, delta, use=use)`` for an odd
+    ``length`` (samples) and ``delta`` in s, by scipy 1.17's own steps (the minimum-norm
+    least-squares solution of the Vandermonde system), so the same bits
+    (``tests/test_peaks.py``)."""
+    from scipy.linalg import lstsq  # loaded with scipy.optimize, which the fits import
+
+    half = length // 2
+    x = np.arange(-half, length - half, dtype=np.float64)
+    x = x[::-1] if use == "conv" else x
+    design = x ** np.arange(3, dtype=np.float64).reshape(-1, 1)
+    wanted = np.zeros(3)
+    wanted[deriv] = float(math.factorial(deriv)) / (delta**deriv)
+    return lstsq(design, wanted, cond=np.finfo(np.float64).eps * max(design.shape))[0]
 
 
 @lru_cache(maxsize=64)
@@ -96,13 +109,13 @@ def smoother(time_s, tau_s: float, lo: int, hi: int):
     lo, hi : int
         The samples that will be read, [lo, hi).
     """
-    from scipy.signal import savgol_filter
-
     dt = float(np.median(np.diff(time_s)))
     length = round(0.5 * tau_s / dt) | 1
     if not 5 <= length < len(time_s):
         return (lambda values: values), 1.0
     if not length // 2 <= lo < hi <= len(time_s) - length // 2:
+        from scipy.signal import savgol_filter  # its edges' polynomial fits
+
         return (lambda values: savgol_filter(values, length, 2)), noise_gain(length)
 
     def smooth(values):

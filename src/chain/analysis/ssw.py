@@ -45,6 +45,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from chain.analysis.peaks import find_peaks
 from chain.analysis.pulses import estimate_baseline
 from chain.analysis.rows import is_ok
 from chain.analysis.selection import apply_selection
@@ -148,8 +149,8 @@ def measure_ssw(
         it clears the floor, ``trailing_min_s`` the time of the crossed pulse's trailing
         minimum (NaN without a distinct bump).
     """
-    # Imported here: scipy.interpolate and scipy.signal take most of a second to import,
-    # and most jobs that import this module (for its tables' names) never measure.
+    # Imported here: most jobs that import this module (for its tables' names) never
+    # measure, and scipy.interpolate takes a tenth of a second to import.
     from scipy.interpolate import CubicSpline
 
     time = np.asarray(time_s, dtype=float)
@@ -233,8 +234,6 @@ def _distinct_bump(smoothed, top: int, last: int, prominence: float):
     Prominence is measured within [top, last], so the crossed pulse itself bounds the
     bump on the near side and the trailing minimum is the lowest point between them.
     """
-    from scipy.signal import find_peaks  # imported here: see measure_ssw
-
     region = smoothed[top : last + 1]
     peaks, properties = find_peaks(region, prominence=prominence)
     if not peaks.size:

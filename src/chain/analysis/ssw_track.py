@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from chain.analysis.peaks import local_maxima, peak_prominence
 from chain.atomic import atomic_output
 from chain.errors import ParameterError
 
@@ -176,44 +177,17 @@ def _first_bump(signal, main_index: int, window_s: float, floor_N: float, time) 
     ``floor_N``) within ``window_s`` of it, or -1.
 
     The first peak ``scipy.signal.find_peaks(signal[main_index:], height=floor_N,
-    prominence=floor_N)`` returns, found without importing scipy.signal (a second, most
-    of an ssw_track job's start-up); ``tests/test_ssw_track.py`` compares the two."""
+    prominence=floor_N)`` returns, stopping at the first (:mod:`chain.analysis.peaks`);
+    ``tests/test_ssw_track.py`` compares the two."""
     if not np.isfinite(window_s):
         return -1
     segment = np.asarray(signal[main_index:], dtype=float)
-    for peak in _local_maxima(segment):
+    for peak in local_maxima(segment):
         if time[main_index + peak] - time[main_index] > window_s:
             return -1
-        if segment[peak] >= floor_N and _prominence(segment, peak) >= floor_N:
+        if segment[peak] >= floor_N and peak_prominence(segment, peak)[0] >= floor_N:
             return int(main_index + peak)
     return -1
-
-
-def _local_maxima(x: np.ndarray) -> np.ndarray:
-    """Indices of the local maxima of ``x`` as find_peaks defines them: a run of equal
-    values higher than both neighbours, not touching either end, taken at its middle
-    sample (the left one of two)."""
-    if x.size < 3:
-        return np.zeros(0, dtype=np.int64)
-    starts = np.r_[0, np.flatnonzero(np.diff(x) != 0) + 1]
-    ends = np.r_[starts[1:] - 1, x.size - 1]
-    level = x[starts]
-    inner = np.arange(1, starts.size - 1)
-    peak = (level[inner - 1] < level[inner]) & (level[inner + 1] < level[inner])
-    runs = inner[peak]
-    return (starts[runs] + ends[runs]) // 2
-
-
-def _prominence(x: np.ndarray, peak: int) -> float:
-    """find_peaks' prominence of ``x[peak]`` (no window): its height above the higher
-    of the lowest points between it and the nearest higher sample on each side (or the
-    end of ``x``)."""
-    top = x[peak]
-    higher_left = np.flatnonzero(x[:peak] > top)
-    higher_right = np.flatnonzero(x[peak + 1 :] > top)
-    left = higher_left[-1] + 1 if higher_left.size else 0
-    right = peak + 1 + higher_right[0] if higher_right.size else x.size
-    return top - max(x[left : peak + 1].min(), x[peak:right].min())
 
 
 def _linked(ssw_time, relative_force, step: float) -> np.ndarray:
