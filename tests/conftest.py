@@ -362,7 +362,9 @@ def built_once(tmp_path_factory) -> Callable[[str, Callable[[Path], None]], Path
         with _exclusive(shared / f"{name}.lock"):
             if not done.exists():
                 shutil.rmtree(folder, ignore_errors=True)
-                folder.mkdir()
+                # Private whatever the umask: a run checks the folders outside its checkout
+                # (a store, numba's cache) and refuses one its group may write in.
+                folder.mkdir(mode=0o700)
                 build(folder)
                 done.touch()
         return folder
