@@ -7,21 +7,13 @@ from __future__ import annotations
 from functools import cached_property
 
 from chain.pipeline.config.ablation import ablation_variants, variant_settings, variant_tolerance
+from chain.pipeline.plan import PartPlan
 from chain.studies.ablation_table import overrides_text
 from chain.studies.mechanism_settings import CANDIDATE_REFERENCE, candidate_variants
 
 
-class AblationPlan:
-    """The facts of the ablation_variants job.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan, whose shared facts it reads.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class AblationPlan(PartPlan):
+    """The facts of the ablation_shots and ablation_variants jobs."""
 
     @cached_property
     def variants(self) -> dict[str, dict]:

@@ -7,20 +7,12 @@ from __future__ import annotations
 
 from functools import cached_property
 
+from chain.pipeline.plan import PartPlan
 from chain.studies.c_sensitivity import sensitivity_plan, shifted_pairs
 
 
-class CSensitivityPlan:
-    """The facts of the c_sensitivity job.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan, whose shared facts it reads.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class CSensitivityPlan(PartPlan):
+    """The facts of the c_sensitivity job."""
 
     @cached_property
     def choices(self) -> dict:

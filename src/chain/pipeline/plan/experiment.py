@@ -12,6 +12,7 @@ from functools import cached_property
 from chain.apparatus.virtual_settings import VirtualExperiment
 from chain.labels import VIRTUAL_SERIES
 from chain.pipeline.config.virtual import virtual_experiment_settings
+from chain.pipeline.plan import PartPlan
 from chain.pipeline.plan.datasets import (
     DEFAULT_CACHE,
     ExperimentPart,
@@ -22,17 +23,8 @@ from chain.pipeline.plan.datasets import (
 )
 
 
-class ExperimentPlan:
-    """The facts of the virtual_experiment, experiment_traces and selection jobs.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan, whose shared facts it reads.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class ExperimentPlan(PartPlan):
+    """The facts of the virtual_experiment, experiment_traces and selection jobs."""
 
     @cached_property
     def chains(self) -> tuple[ExperimentPart, ...]:

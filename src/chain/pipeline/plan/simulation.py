@@ -3,21 +3,13 @@
 
 from __future__ import annotations
 
+from chain.pipeline.plan import PartPlan
 from chain.pipeline.plan.jobs import chain_of
 from chain.pipeline.plan.resources import simulation_needs, simulation_threads
 
 
-class SimulationPlan:
-    """The facts of the simulate and long_chain jobs of a run.
-
-    Parameters
-    ----------
-    plan : RunPlan
-        The run's plan, whose shared facts it reads.
-    """
-
-    def __init__(self, plan):
-        self.plan = plan
+class SimulationPlan(PartPlan):
+    """The facts of the simulate and long_chain jobs of a run."""
 
     @property
     def field_chains(self) -> tuple[int, ...]:
